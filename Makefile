@@ -1,0 +1,34 @@
+# The two commands of the README: `make demo` and `make test`. Both set everything up first.
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+EXTRAS ?= all
+
+.PHONY: demo test setup lint bench clean
+
+demo: $(VENV)/.installed
+	$(BIN)/facelib info examples/fap/xface_smile.fap
+
+test: $(VENV)/.installed
+	$(BIN)/ruff check .
+	$(BIN)/python -m pytest
+
+setup: $(VENV)/.installed
+
+# Debian packages first (tools/debian-deps installs them as root, otherwise prints the
+# apt-get command), then a virtualenv with the package and its extras.
+$(VENV)/.installed: pyproject.toml tools/debian-packages.txt tools/debian-deps
+	tools/debian-deps
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[$(EXTRAS)]"
+	touch $@
+
+lint: $(VENV)/.installed
+	$(BIN)/ruff check .
+
+bench: $(VENV)/.installed
+	$(BIN)/python benchmarks/run.py
+
+clean:
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache

@@ -1,0 +1,81 @@
+"""The one exception tree of facelib.
+
+Every error facelib raises on purpose is a :class:`FacelibError`. Subclasses say which
+kind of input was wrong; each message names the offending value and, where there is one,
+the file and line it came from.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = [
+    "FaceModelError",
+    "FacelibError",
+    "FapFormatError",
+    "FdlError",
+    "MissingExtraError",
+    "ParameterError",
+    "RenderError",
+    "SpeechError",
+]
+
+
+class FacelibError(Exception):
+    """Base class of every error facelib raises on purpose.
+
+    Parameters
+    ----------
+    message:
+        What is wrong, naming the offending value.
+    path:
+        The file the problem is in, if any.
+    line:
+        The 1-based line number in ``path``, if known.
+    """
+
+    def __init__(self, message: str, *, path: str | Path | None = None, line: int | None = None):
+        self.message = message
+        self.path = None if path is None else str(path)
+        self.line = line
+        super().__init__(self._format())
+
+    def _format(self) -> str:
+        if self.path is None:
+            return self.message
+        where = self.path if self.line is None else f"{self.path}:{self.line}"
+        return f"{where}: {self.message}"
+
+
+class ParameterError(FacelibError, ValueError):
+    """A value passed to a facelib function is out of range or of the wrong kind."""
+
+
+class FapFormatError(FacelibError):
+    """A ``.fap`` file (or FAP data) cannot be read or is malformed."""
+
+
+class FdlError(FacelibError):
+    """An ``.fdl`` storyboard or script failed: syntax, runtime, sandbox limits, bad values."""
+
+
+class FaceModelError(FacelibError):
+    """A face definition (mesh, feature points, regions, pivots) is missing or inconsistent."""
+
+
+class SpeechError(FacelibError):
+    """Speech audio or transcript cannot be used (unreadable, silent, implausible alignment)."""
+
+
+class RenderError(FacelibError):
+    """Rendering or video encoding failed (no OpenGL platform, encoder error, ...)."""
+
+
+class MissingExtraError(FacelibError, ImportError):
+    """An optional dependency is needed for this feature but is not installed."""
+
+    def __init__(self, feature: str, extra: str, module: str):
+        super().__init__(
+            f"{feature} needs the '{module}' package, which is not installed; "
+            f"install it with: pip install 'facelib[{extra}]'"
+        )

@@ -1,0 +1,128 @@
+"""``Storyboard``: what a storyboard asks for, as plain timed cues.
+
+Times are integer milliseconds from the start of the animation (no float drift). Every cue
+keeps ``origin`` (file, line) of the script line that made it, so later stages can name it
+in errors.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+__all__ = ["ExpressionCue", "GazeCue", "Origin", "SpeechSpec", "Storyboard", "VisemeCue"]
+
+Origin = tuple[str, int]
+"""(file, 1-based line) of the script text a cue came from."""
+
+
+@dataclass(frozen=True, slots=True)
+class ExpressionCue:
+    """Show expression ``name`` from ``start_ms`` for ``duration_ms``.
+
+    ``intensity`` scales the expression's full-intensity FAP values (1.0 = as defined).
+    ``ramp_in_ms`` / ``ramp_out_ms`` of None leave the ramps to the expression generator.
+    """
+
+    name: str
+    start_ms: int
+    duration_ms: int
+    intensity: float = 1.0
+    ramp_in_ms: int | None = None
+    ramp_out_ms: int | None = None
+    origin: Origin | None = None
+
+    @property
+    def end_ms(self) -> int:
+        return self.start_ms + self.duration_ms
+
+
+@dataclass(frozen=True, slots=True)
+class GazeCue:
+    """Run eye behaviour ``behaviour`` (``"lookTo"``, ``"default"``, ...) with ``args`` (the
+    eye-script tuple's values between the name and the duration) from ``start_ms``."""
+
+    behaviour: str
+    args: tuple[str | float, ...]
+    start_ms: int
+    duration_ms: int
+    origin: Origin | None = None
+
+    @property
+    def end_ms(self) -> int:
+        return self.start_ms + self.duration_ms
+
+
+@dataclass(frozen=True, slots=True)
+class VisemeCue:
+    """One entry of a stored viseme script (the thesis's ``Sentence``): viseme ``viseme``
+    as written in the script (``"silence"``, ``"A"``, ``"kg"``, ...)."""
+
+    viseme: str
+    start_ms: int
+    duration_ms: int
+    origin: Origin | None = None
+
+    @property
+    def end_ms(self) -> int:
+        return self.start_ms + self.duration_ms
+
+
+@dataclass(frozen=True, slots=True)
+class SpeechSpec:
+    """What the character says, starting at ``start_ms``: audio and/or transcript text, or a
+    stored viseme script (used as it is, without speech processing)."""
+
+    audio: Path | None = None
+    text: str | None = None
+    visemes: tuple[VisemeCue, ...] | None = None
+    start_ms: int = 0
+    origin: Origin | None = None
+
+
+def _frozen_map(value: Mapping[str, Any]) -> Mapping[str, Any]:
+    return MappingProxyType(dict(value))
+
+
+@dataclass(frozen=True, slots=True)
+class Storyboard:
+    """A loaded storyboard.
+
+    Attributes
+    ----------
+    path: the storyboard file, or None when built in memory.
+    fps: frame rate of the animation (frames per second).
+    seed: seed of every random process (saccades, blinks, head noise).
+    speech: what is said, or None.
+    expressions, gaze: the expression and eye-behaviour cues, in time order.
+    expression_defs: expressions the storyboard defines or overrides:
+        name -> {FAP name or id: value at full intensity, in FAP units}.
+    gaze_defs: eye behaviours the storyboard defines or overrides: name -> parameters.
+    output: where the storyboard asks the ``.fap`` to go, or None.
+    """
+
+    path: Path | None = None
+    fps: float = 25.0
+    seed: int = 0
+    speech: SpeechSpec | None = None
+    expressions: tuple[ExpressionCue, ...] = ()
+    gaze: tuple[GazeCue, ...] = ()
+    expression_defs: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    gaze_defs: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    output: Path | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
+        object.__setattr__(self, "gaze_defs", _frozen_map(self.gaze_defs))
+
+    @property
+    def cues_end_ms(self) -> int:
+        """End of the last expression, gaze or stored-viseme cue (speech audio may last
+        longer; the animation pipeline takes the longest track)."""
+        ends = [c.end_ms for c in (*self.expressions, *self.gaze)]
+        if self.speech is not None and self.speech.visemes:
+            ends += [c.end_ms for c in self.speech.visemes]
+        return max(ends, default=0)
