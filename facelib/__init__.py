@@ -6,8 +6,8 @@ and plotting load on first use.
 """
 
 from facelib.errors import (
-    FaceModelError,
     FacelibError,
+    FaceModelError,
     FapFormatError,
     FdlError,
     MissingExtraError,
@@ -15,7 +15,7 @@ from facelib.errors import (
     RenderError,
     SpeechError,
 )
-from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point
+from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
 
 __version__ = "0.1.0"
 
@@ -33,4 +33,6 @@ __all__ = [
     "__version__",
     "fap",
     "feature_point",
+    "read_fap",
+    "write_fap",
 ]

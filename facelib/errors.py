@@ -12,6 +12,7 @@ from pathlib import Path
 __all__ = [
     "FaceModelError",
     "FacelibError",
+    "FacelibWarning",
     "FapFormatError",
     "FdlError",
     "MissingExtraError",
@@ -79,3 +80,7 @@ class MissingExtraError(FacelibError, ImportError):
             f"{feature} needs the '{module}' package, which is not installed; "
             f"install it with: pip install 'facelib[{extra}]'"
         )
+
+
+class FacelibWarning(UserWarning):
+    """Something was accepted but looked irregular (e.g. frames missing from a ``.fap``)."""

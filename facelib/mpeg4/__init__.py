@@ -1,6 +1,7 @@
 """The MPEG-4 facial animation vocabulary: FAP and feature-point tables, FAPU, streams and
 ``.fap`` files."""
 
+from facelib.mpeg4.fapfile import DIALECTS, FapFile, read_fap, read_fap_file, write_fap
 from facelib.mpeg4.stream import EXPRESSION_FIELDS, VISEME_FIELDS, FapStream
 from facelib.mpeg4.tables import (
     ANGLE_UNIT,
@@ -19,6 +20,7 @@ from facelib.mpeg4.track import FapTrack
 
 __all__ = [
     "ANGLE_UNIT",
+    "DIALECTS",
     "EXPRESSION_FIELDS",
     "FAPU_NAMES",
     "FAPU_SCALE",
@@ -26,6 +28,7 @@ __all__ = [
     "N_STANDARD_FAPS",
     "VISEME_FIELDS",
     "Fap",
+    "FapFile",
     "FapStream",
     "FapTrack",
     "FeaturePoint",
@@ -33,4 +36,7 @@ __all__ = [
     "fap_table",
     "feature_point",
     "feature_point_table",
+    "read_fap",
+    "read_fap_file",
+    "write_fap",
 ]

@@ -93,9 +93,10 @@ class FapStream:
                 raise ParameterError(
                     f"{name} must have shape ({len(values)}, {width}), got {data.shape}"
                 )
-            if not np.issubdtype(data.dtype, np.integer):
-                if not np.array_equal(data, np.round(data)):
-                    raise ParameterError(f"{name} fields must be integers")
+            if not np.issubdtype(data.dtype, np.integer) and not np.array_equal(
+                data, np.round(data)
+            ):
+                raise ParameterError(f"{name} fields must be integers")
             object.__setattr__(self, name, _frozen(data.astype(np.int16)))
 
     # -- construction -----------------------------------------------------------------
@@ -168,7 +169,7 @@ class FapStream:
         """
         if not (isinstance(fps, (int, float)) and np.isfinite(fps) and fps > 0):
             raise ParameterError(f"fps must be a positive number, got {fps!r}")
-        n_out = max(int(round(self.duration * fps)), 1 if self.n_frames else 0)
+        n_out = max(round(self.duration * fps), 1 if self.n_frames else 0)
         if self.n_frames == 0:
             return FapStream.zeros(0, fps=fps)
         t = np.arange(n_out) / fps
@@ -198,7 +199,10 @@ class FapStream:
                 return None
             width = next(p.shape[1] for p in parts if p is not None)
             return np.concatenate(
-                [np.zeros((len(s), width), np.int16) if p is None else p for s, p in zip(streams, parts)]
+                [
+                    np.zeros((len(s), width), np.int16) if p is None else p
+                    for s, p in zip(streams, parts, strict=True)
+                ]
             )
 
         return FapStream(

@@ -49,9 +49,9 @@ class FapTrack:
                 f"weights must lie in [0, 1], got range [{weight.min()}, {weight.max()}]"
             )
         for name, array in (("values", values), ("weight", weight)):
-            array = array.copy()
-            array.flags.writeable = False
-            object.__setattr__(self, name, array)
+            frozen = array.copy()
+            frozen.flags.writeable = False
+            object.__setattr__(self, name, frozen)
         object.__setattr__(self, "fps", float(self.fps))
 
     @classmethod
