@@ -1,0 +1,108 @@
+"""The expression library: named sets of FAP values at full intensity.
+
+The default library is ``facelib/data/expressions.csv`` (one row per expression and FAP,
+with a note on where each value comes from). Storyboards add or override expressions with
+``Storyboard.expression_defs``.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from types import MappingProxyType
+
+import numpy as np
+
+from facelib.errors import FdlError, ParameterError
+from facelib.fdl.storyboard import Origin
+from facelib.mpeg4.tables import N_FAPS, fap
+
+__all__ = ["Expression", "ExpressionLibrary", "default_library"]
+
+
+@dataclass(frozen=True, eq=False)
+class Expression:
+    """One expression at full intensity.
+
+    values: ``(84,) float32`` FAP values in FAP units (0 where the expression is silent).
+    mask: ``(84,) bool``, the FAPs the expression drives.
+    """
+
+    name: str
+    values: np.ndarray
+    mask: np.ndarray
+
+    @classmethod
+    def from_faps(cls, name: str, faps: Mapping[str | int, float]) -> Expression:
+        """Build from ``{FAP name or id: value}``; unknown FAPs raise ``ParameterError``."""
+        values = np.zeros(N_FAPS, np.float32)
+        mask = np.zeros(N_FAPS, bool)
+        for key, value in faps.items():
+            column = fap(key).index
+            if column < 2:
+                raise ParameterError(f"expression {name!r}: FAP {key!r} is high level; "
+                                     "give low-level FAPs 3-84")
+            if not np.isfinite(float(value)):
+                raise ParameterError(f"expression {name!r}: FAP {key!r} value {value!r} "
+                                     "is not finite")
+            values[column] = float(value)
+            mask[column] = True
+        values.flags.writeable = False
+        mask.flags.writeable = False
+        return cls(name, values, mask)
+
+
+@dataclass(frozen=True)
+class ExpressionLibrary:
+    """Expressions by lower-case name."""
+
+    expressions: Mapping[str, Expression]
+
+    def __contains__(self, name: object) -> bool:
+        return isinstance(name, str) and name.lower() in self.expressions
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.expressions)
+
+    def get(self, name: str, *, origin: Origin | None = None) -> Expression:
+        """The expression called ``name`` (case-insensitive).
+
+        An unknown name raises ``FdlError`` at ``origin`` (the script line that asked for
+        it), suggesting the closest known name.
+        """
+        found = self.expressions.get(name.lower())
+        if found is not None:
+            return found
+        close = difflib.get_close_matches(name.lower(), self.names, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        path, line = origin if origin is not None else (None, None)
+        raise FdlError(f"unknown expression {name!r}{hint} (known: {', '.join(self.names)})",
+                       path=path, line=line)
+
+    def with_defs(self, defs: Mapping[str, Mapping[str | int, float]]) -> ExpressionLibrary:
+        """A library with ``defs`` (name -> {FAP: value}) added or replacing entries."""
+        if not defs:
+            return self
+        merged = dict(self.expressions)
+        for name, faps in defs.items():
+            merged[name.lower()] = Expression.from_faps(name.lower(), faps)
+        return ExpressionLibrary(MappingProxyType(merged))
+
+
+@cache
+def default_library() -> ExpressionLibrary:
+    """The expressions shipped with facelib (read once)."""
+    table: dict[str, dict[str, float]] = {}
+    source = resources.files("facelib.data").joinpath("expressions.csv")
+    with source.open(encoding="utf-8", newline="") as f:
+        rows = csv.DictReader(line for line in f if not line.startswith("#"))
+        for row in rows:
+            table.setdefault(row["expression"], {})[row["fap"]] = float(row["value"])
+    return ExpressionLibrary(
+        MappingProxyType({name: Expression.from_faps(name, faps) for name, faps in table.items()})
+    )

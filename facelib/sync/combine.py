@@ -1,0 +1,133 @@
+"""The synchronizer: resolves the generators' conflicts into one FAP stream (thesis 4.2.4).
+
+Each step is a small pure function over :class:`FapTrack` objects:
+
+1. :func:`blend` expressions with visemes (mouth conflict, eq. 4.11);
+2. :func:`blend` the result with gaze (eyelid and head conflict, 25 % gaze);
+3. :func:`close_lids` for blinks, which no expression may hold open;
+4. :func:`add_head_noise` where gaze does not move the head;
+5. :func:`to_stream`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facelib.mpeg4.stream import FapStream
+from facelib.mpeg4.tables import ANGLE_UNIT, fap
+from facelib.mpeg4.track import FapTrack
+from facelib.sync.noise import perlin1d
+from facelib.sync.rules import HeadNoise, SyncRules
+
+__all__ = ["HEAD_FAPS", "add_head_noise", "blend", "close_lids", "combine", "to_stream"]
+
+HEAD_FAPS = tuple(fap(name).index for name in ("head_pitch", "head_yaw", "head_roll"))
+"""Columns of FAP 48-50."""
+_UPPER_LIDS = (fap("close_t_l_eyelid").index, fap("close_t_r_eyelid").index)
+_LOWER_LIDS = (fap("close_b_l_eyelid").index, fap("close_b_r_eyelid").index)
+_LID_CLOSED = 1024.0  # IRISD units: the lid travels one iris diameter
+_LOWER_LID_CLOSED = 150.0  # in a blink the lower lid rises a little (IRISD units)
+
+
+def blend(a: FapTrack, b: FapTrack, *, weight_a: float, weight_b: float) -> FapTrack:
+    """Weighted blend of two tracks.
+
+    Per frame and FAP: ``(wa*A + wb*B) / (wa + wb)`` with ``wa = weight_a * a.weight`` and
+    ``wb = weight_b * b.weight``. Where only one track drives a FAP, its value is kept as
+    it is; with both at full weight and weights (1, 3) this is eq. 4.11, (E + 3V) / 4.
+    The result's weight is the larger of the two.
+    """
+    wa = a.weight.astype(np.float64) * weight_a
+    wb = b.weight.astype(np.float64) * weight_b
+    total = wa + wb
+    mixed = (wa * a.values + wb * b.values) / np.where(total > 0, total, 1.0)
+    lone_a = (a.weight > 0) & (b.weight == 0)
+    lone_b = (b.weight > 0) & (a.weight == 0)
+    values = np.where(lone_a, a.values, np.where(lone_b, b.values, mixed))
+    return FapTrack(a.fps, values.astype(np.float32), np.maximum(a.weight, b.weight))
+
+
+def close_lids(track: FapTrack, closure: np.ndarray) -> FapTrack:
+    """Blinks: move the upper lids ``closure`` (``(n_frames,)`` in [0, 1]) of the way from
+    where they are to fully closed, the lower lids a little; 1 closes the eye whatever an
+    expression or gaze asked of the lids."""
+    closure = np.asarray(closure, np.float64)[:, None]
+    values = track.values.astype(np.float64)
+    weight = track.weight.copy()
+    for columns, target in ((_UPPER_LIDS, _LID_CLOSED), (_LOWER_LIDS, _LOWER_LID_CLOSED)):
+        cols = list(columns)
+        values[:, cols] += closure * np.maximum(target - values[:, cols], 0.0)
+        weight[:, cols] = np.maximum(weight[:, cols], (closure > 0).astype(np.float32))
+    return FapTrack(track.fps, values.astype(np.float32), weight)
+
+
+def add_head_noise(
+    track: FapTrack,
+    *,
+    noise: HeadNoise,
+    seed: int,
+    head_driven: np.ndarray,
+    speaking: np.ndarray | None = None,
+) -> FapTrack:
+    """Add Perlin head motion to FAP 48-50, faded out where ``head_driven`` (``(n_frames,)``
+    in [0, 1], how strongly gaze moves the head) is 1, so gaze-driven head turns are kept.
+
+    While ``speaking`` (``(n_frames,) bool``) the motion is livelier: amplitude and
+    frequency grow by ``noise.speaking_amplitude`` / ``speaking_frequency``, eased over
+    about half a second so there is no jolt.
+    """
+    n = track.n_frames
+    t = np.arange(n) / track.fps
+    talk = np.zeros(n) if speaking is None else np.asarray(speaking, np.float64)[:n]
+    if talk.size < n:
+        talk = np.pad(talk, (0, n - talk.size))
+    width = max(round(0.5 * track.fps), 1)
+    padded = np.pad(talk, width, mode="edge")
+    talk = np.convolve(padded, np.ones(width) / width, "same")[width:-width]
+    rate = noise.frequency_hz * (1.0 + (noise.speaking_frequency - 1.0) * talk)
+    phase = np.concatenate([[0.0], np.cumsum(rate[:-1])]) / track.fps if n else t
+    gain = 1.0 + (noise.speaking_amplitude - 1.0) * talk
+    free = 1.0 - np.clip(np.asarray(head_driven, np.float64), 0.0, 1.0)
+    values = track.values.astype(np.float64)
+    weight = track.weight.copy()
+    for axis, column in enumerate(HEAD_FAPS):
+        wave = perlin1d(phase, seed=seed * 3 + axis, octaves=noise.octaves)
+        amplitude = np.deg2rad(noise.amplitude_deg[axis]) / ANGLE_UNIT
+        values[:, column] += wave * amplitude * gain * free
+        weight[:, column] = np.maximum(weight[:, column], np.float32(1.0))
+    return FapTrack(track.fps, values.astype(np.float32), weight)
+
+
+def to_stream(track: FapTrack) -> FapStream:
+    """The final stream: every FAP that is driven anywhere is set in every frame (0, the
+    neutral value, where nothing drives it), so players never hold a stale value."""
+    driven = (track.weight > 0).any(axis=0)
+    mask = np.broadcast_to(driven, track.values.shape)
+    return FapStream(track.fps, track.values, mask.copy())
+
+
+def combine(
+    *,
+    expressions: FapTrack,
+    visemes: FapTrack,
+    gaze: FapTrack,
+    blinks: np.ndarray | None = None,
+    speaking: np.ndarray | None = None,
+    rules: SyncRules | None = None,
+    seed: int = 0,
+) -> FapStream:
+    """Resolve the three generators' tracks (all of one length and fps) into a stream.
+
+    blinks: ``(n_frames,)`` lid closure in [0, 1] from the eye-behaviour model, or None.
+    speaking: ``(n_frames,) bool`` where the character talks (livelier head noise).
+    """
+    rules = rules or SyncRules.load()
+    face = blend(expressions, visemes, weight_a=rules.mouth[0], weight_b=rules.mouth[1])
+    face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
+    if blinks is not None:
+        face = close_lids(face, blinks)
+    if rules.head_noise is not None:
+        head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
+        face = add_head_noise(face, noise=rules.head_noise, seed=seed,
+                              head_driven=head_driven, speaking=speaking)
+    return to_stream(face)

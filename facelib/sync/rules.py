@@ -1,0 +1,86 @@
+"""The synchronizer's rules, read from ``facelib/data/sync.json`` (see its comments)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from facelib.errors import ParameterError
+
+__all__ = ["HeadNoise", "SyncRules"]
+
+
+@dataclass(frozen=True)
+class HeadNoise:
+    """Idle head motion: Perlin noise of ``amplitude_deg`` (pitch, yaw, roll) at about
+    ``frequency_hz``; while speaking the amplitude and frequency are multiplied by
+    ``speaking_amplitude`` and ``speaking_frequency``."""
+
+    amplitude_deg: tuple[float, float, float] = (1.5, 2.0, 1.0)
+    frequency_hz: float = 0.25
+    octaves: int = 2
+    speaking_amplitude: float = 1.6
+    speaking_frequency: float = 1.6
+
+
+@dataclass(frozen=True)
+class SyncRules:
+    """Weights of the conflict resolution.
+
+    mouth: (expression, viseme) weights where both drive a FAP; (1, 3) is eq. 4.11.
+    eyes_head: (expression, gaze) weights on eyelids and head; (0.75, 0.25) in the thesis.
+    expression_importance, viseme_importance: name -> factor in [0, 1] on that side's weight.
+    head_noise: idle head motion, or None for none.
+    """
+
+    mouth: tuple[float, float] = (1.0, 3.0)
+    eyes_head: tuple[float, float] = (0.75, 0.25)
+    expression_importance: Mapping[str, float] = field(default_factory=dict)
+    viseme_importance: Mapping[str, float] = field(default_factory=dict)
+    head_noise: HeadNoise | None = HeadNoise()
+
+    @classmethod
+    def load(cls, path: str | Path | None = None) -> SyncRules:
+        """Rules from a JSON file shaped like ``facelib/data/sync.json`` (the default)."""
+        if path is None:
+            text = resources.files("facelib.data").joinpath("sync.json").read_text("utf-8")
+            where = "facelib/data/sync.json"
+        else:
+            text, where = Path(path).read_text("utf-8"), str(path)
+        try:
+            data: dict[str, Any] = json.loads(text)
+            noise = data.get("head_noise")
+            rules = cls(
+                mouth=(float(data["mouth"]["expression"]), float(data["mouth"]["viseme"])),
+                eyes_head=(float(data["eyes_head"]["expression"]),
+                           float(data["eyes_head"]["gaze"])),
+                expression_importance=MappingProxyType(
+                    {k.lower(): float(v) for k, v in data.get("expression_importance", {}).items()}
+                ),
+                viseme_importance=MappingProxyType(
+                    {k: float(v) for k, v in data.get("viseme_importance", {}).items()}
+                ),
+                head_noise=None if noise is None else HeadNoise(
+                    amplitude_deg=tuple(float(noise["amplitude_deg"][k])  # type: ignore[arg-type]
+                                        for k in ("pitch", "yaw", "roll")),
+                    frequency_hz=float(noise["frequency_hz"]),
+                    octaves=int(noise["octaves"]),
+                    speaking_amplitude=float(noise["speaking_amplitude"]),
+                    speaking_frequency=float(noise["speaking_frequency"]),
+                ),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ParameterError(f"bad synchronizer rules: {exc!r}", path=where) from exc
+        for name, value in (*rules.expression_importance.items(),
+                            *rules.viseme_importance.items()):
+            if not 0.0 <= value <= 1.0:
+                raise ParameterError(f"importance of {name!r} is {value}, not in [0, 1]",
+                                     path=where)
+        if min(*rules.mouth, *rules.eyes_head) < 0:
+            raise ParameterError("blend weights must not be negative", path=where)
+        return rules
