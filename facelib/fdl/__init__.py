@@ -1,5 +1,8 @@
 """FDL, the Face Description Language: sandboxed Lua storyboards."""
 
+from facelib.fdl.describe import describe
+from facelib.fdl.loader import load, loads
+from facelib.fdl.sandbox import Sandbox
 from facelib.fdl.storyboard import (
     ExpressionCue,
     GazeCue,
@@ -8,4 +11,14 @@ from facelib.fdl.storyboard import (
     VisemeCue,
 )
 
-__all__ = ["ExpressionCue", "GazeCue", "SpeechSpec", "Storyboard", "VisemeCue"]
+__all__ = [
+    "ExpressionCue",
+    "GazeCue",
+    "Sandbox",
+    "SpeechSpec",
+    "Storyboard",
+    "VisemeCue",
+    "describe",
+    "load",
+    "loads",
+]

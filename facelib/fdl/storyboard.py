@@ -101,6 +101,10 @@ class Storyboard:
     expression_defs: expressions the storyboard defines or overrides:
         name -> {FAP name or id: value at full intensity, in FAP units}.
     gaze_defs: eye behaviours the storyboard defines or overrides: name -> parameters.
+    expression_mixes: expressions defined by mixing library expressions:
+        name -> {library expression name: weight}; the expression generator resolves them
+        against its library and adds ``expression_defs[name]`` (FAP overrides) on top.
+        Mixes of expressions the storyboard itself defines are resolved at load time.
     output: where the storyboard asks the ``.fap`` to go, or None.
     """
 
@@ -113,10 +117,12 @@ class Storyboard:
     expression_defs: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     gaze_defs: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     output: Path | None = None
+    expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
         object.__setattr__(self, "gaze_defs", _frozen_map(self.gaze_defs))
+        object.__setattr__(self, "expression_mixes", _frozen_map(self.expression_mixes))
 
     @property
     def cues_end_ms(self) -> int:

@@ -1,0 +1,216 @@
+-- facelib FDL sandbox bootstrap (trusted code).
+--
+-- Runs once per Lua state with the full standard library, keeps what the host needs in
+-- local upvalues (debug.sethook/getinfo, load, the real libraries), removes every global,
+-- and returns the host's entry points. User chunks never see these locals: they run with
+-- their own environment table holding only the whitelist below (plus facelib's recorders).
+--
+-- Arguments from the host: log (a Python callable receiving one string per print).
+
+local host_log = ...
+
+local debug_sethook, debug_getinfo = debug.sethook, debug.getinfo
+local raw_load, raw_pcall, raw_xpcall, raw_error = load, pcall, xpcall, error
+local raw_type, raw_select, raw_tostring, raw_tonumber = type, select, tostring, tonumber
+local raw_pairs, raw_ipairs, raw_assert = pairs, ipairs, assert
+local raw_setmetatable, raw_getmetatable, raw_collect = setmetatable, getmetatable, collectgarbage
+local string_lib, table_lib, math_lib, utf8_lib = string, table, math, utf8
+local table_concat, str_gsub = table.concat, string.gsub
+local math_randomseed = math.randomseed
+local string_mt = raw_getmetatable("")
+
+-- Instructions between two calls of the count hook.
+local STEP = 1000
+-- Pattern functions run in C where the hook cannot stop them: refuse calls whose
+-- worst-case backtracking (subject length ^ (quantifiers + 1)) exceeds this many steps.
+local PATTERN_WORK = 1e8
+-- string.rep and table.move loop in C even when nothing is allocated: bound their counts.
+local MAX_REPEAT = 1 << 27
+
+-- Unique error value that marks a sandbox limit; user code can never obtain it.
+local FATAL = raw_setmetatable({}, { __tostring = function() return "sandbox limit" end })
+
+local state = { used = 0, budget = 0, source = "", line = -1, fatal = false, err_line = -1 }
+
+local function hook()
+  state.used = state.used + STEP
+  local info = debug_getinfo(2, "Sl")
+  if info and info.source == state.source and info.currentline > 0 then
+    state.line = info.currentline
+  end
+  if state.used > state.budget then
+    if not state.fatal then state.fatal = "instructions" end
+    raw_error(FATAL, 0)
+  end
+end
+
+local function check_fatal(ok, ...)
+  if not ok then
+    local e = ...
+    if e == "not enough memory" and not state.fatal then state.fatal = "memory" end
+    if e == FATAL or state.fatal then raw_error(FATAL, 0) end
+  end
+  return ok, ...
+end
+
+-- pcall for user code: catches ordinary errors, never a sandbox limit.
+local function safe_pcall(f, ...)
+  return check_fatal(raw_pcall(f, ...))
+end
+
+local function safe_print(...)
+  local n = raw_select("#", ...)
+  local parts = {}
+  for i = 1, n do parts[i] = raw_tostring((raw_select(i, ...))) end
+  host_log(table_concat(parts, "\t"))
+end
+
+local function copy(t, drop)
+  local c = {}
+  for k, v in raw_pairs(t) do
+    if not (drop and drop[k]) then c[k] = v end
+  end
+  return c
+end
+
+local function guard_pattern(fn, name, pattern_arg)
+  return function(s, p, ...)
+    local n = #raw_tostring(s)
+    if raw_type(p) == "string" or raw_type(p) == "number" then
+      local plain = name == "find" and raw_select(2, ...)
+      if not plain then
+        local _, q = str_gsub(raw_tostring(p), "[%*%+%-%?]", "")
+        if pattern_arg and n > 0 and (n + 1.0) ^ (q + 1) > PATTERN_WORK then
+          raw_error("string." .. name .. ": pattern with " .. q .. " quantifiers on a "
+            .. n .. "-byte string is too costly for the sandbox", 2)
+        end
+      end
+    end
+    return fn(s, p, ...)
+  end
+end
+
+local function guarded_string()
+  local s = copy(string_lib, { dump = true })
+  s.find = guard_pattern(string_lib.find, "find", true)
+  s.match = guard_pattern(string_lib.match, "match", true)
+  s.gmatch = guard_pattern(string_lib.gmatch, "gmatch", true)
+  s.gsub = guard_pattern(string_lib.gsub, "gsub", true)
+  local rep = string_lib.rep
+  s.rep = function(str, count, sep)
+    local c = raw_tonumber(count)
+    if c and c > MAX_REPEAT then
+      raw_error("string.rep: count " .. raw_tostring(count) .. " is larger than the sandbox allows ("
+        .. MAX_REPEAT .. ")", 2)
+    end
+    return rep(str, count, sep)
+  end
+  return s
+end
+
+local function guarded_table()
+  local t = copy(table_lib)
+  local move = table_lib.move
+  t.move = function(a1, f, e, tpos, a2)
+    local ff, ee = raw_tonumber(f), raw_tonumber(e)
+    if ff and ee and ee - ff >= MAX_REPEAT then
+      raw_error("table.move: range " .. raw_tostring(f) .. ".." .. raw_tostring(e)
+        .. " is larger than the sandbox allows", 2)
+    end
+    return move(a1, f, e, tpos, a2)
+  end
+  return t
+end
+
+-- Recorder for facelib's storyboard functions (say, show, look, ...): remembers the call,
+-- its first argument and the user line it came from; the host validates afterwards.
+local function recorder(calls, kind)
+  return function(...)
+    local info = debug_getinfo(2, "Sl")
+    local line = (info and info.source == state.source) and info.currentline or -1
+    calls[#calls + 1] = { kind, (...), line, raw_select("#", ...) }
+  end
+end
+
+local function new_env(api_names, calls)
+  local s = guarded_string()
+  string_mt.__index = s
+  local env = {
+    string = s,
+    table = guarded_table(),
+    math = copy(math_lib, { randomseed = true }),
+    utf8 = copy(utf8_lib),
+    pairs = raw_pairs,
+    ipairs = raw_ipairs,
+    select = raw_select,
+    type = raw_type,
+    tostring = raw_tostring,
+    tonumber = raw_tonumber,
+    error = raw_error,
+    pcall = safe_pcall,
+    assert = raw_assert,
+    print = safe_print,
+  }
+  for _, name in raw_ipairs(api_names) do env[name] = recorder(calls, name) end
+  return env
+end
+
+local function handler(e)
+  if e == FATAL or state.fatal then return FATAL end
+  for level = 2, 200 do
+    local info = debug_getinfo(level, "Sl")
+    if not info then break end
+    if info.source == state.source and info.currentline > 0 then
+      state.err_line = info.currentline
+      break
+    end
+  end
+  if raw_type(e) ~= "string" then
+    e = "error object is a " .. raw_type(e) .. " value"
+  end
+  return e
+end
+
+-- run(original, marked, chunkname, budget, seed, api_names)
+--   original: the user's text, compiled once to report its own syntax errors.
+--   marked: the same text with table constructors wrapped in __fdl_at(line, {...}).
+-- Returns true, env, lines, calls, used  or  false, kind, message, line, used
+-- with kind one of "syntax", "runtime", "instructions", "memory".
+local function run(original, marked, chunkname, budget, seed, api_names)
+  local f, err = raw_load(original, chunkname, "t", {})
+  if not f then return false, "syntax", err, -1, 0 end
+  f = nil
+  local calls = {}
+  local env = new_env(api_names, calls)
+  local lines = raw_setmetatable({}, { __mode = "k" })
+  local function at(line, t)
+    if raw_type(t) == "table" and raw_type(line) == "number" then lines[t] = line end
+    return t
+  end
+  f, err = raw_load(marked, chunkname, "t", env)
+  if not f then return false, "syntax", err, -1, 0 end
+  math_randomseed(seed)
+  state.used, state.budget, state.source = 0, budget, chunkname
+  state.line, state.fatal, state.err_line = -1, false, -1
+  debug_sethook(hook, "", STEP)
+  local ok, e = raw_xpcall(f, handler, at)
+  debug_sethook()
+  if ok then return true, env, lines, calls, state.used end
+  f, env, lines, calls = nil, nil, nil, nil
+  raw_collect("collect")
+  if state.fatal then return false, state.fatal, "", state.line, state.used end
+  if e == "not enough memory" then return false, "memory", "", state.line, state.used end
+  return false, "runtime", raw_tostring(e), state.err_line, state.used
+end
+
+local function collect()
+  raw_collect("collect")
+end
+
+-- The user must not reach the real libraries through the global table or the string
+-- metatable; lock the latter against getmetatable (never exposed anyway).
+string_mt.__metatable = false
+local G = _G
+for k in raw_pairs(G) do G[k] = nil end
+
+return run, collect

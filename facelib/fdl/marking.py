@@ -1,0 +1,158 @@
+"""Mark Lua table constructors with their source line.
+
+Lua keeps no line numbers for table values, yet every storyboard cue must name the line it
+came from. :func:`mark_tables` rewrites each table constructor ``{ ... }`` into
+``__fdl_at(LINE, { ... })`` (and a call argument ``f{ ... }`` into
+``f(__fdl_at(LINE, { ... }))``) without adding or removing newlines, so the marked chunk
+reports the same line numbers as the original. The sandbox passes ``__fdl_at`` as a local
+that records ``table -> line`` in a weak table.
+"""
+
+from __future__ import annotations
+
+import re
+
+__all__ = ["AT_NAME", "mark_tables"]
+
+AT_NAME = "__fdl_at"
+
+_KEYWORDS = frozenset(
+    [
+        "and",
+        "break",
+        "do",
+        "else",
+        "elseif",
+        "end",
+        "false",
+        "for",
+        "function",
+        "goto",
+        "if",
+        "in",
+        "local",
+        "nil",
+        "not",
+        "or",
+        "repeat",
+        "return",
+        "then",
+        "true",
+        "until",
+        "while",
+    ]
+)
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_NUMBER = re.compile(
+    r"0[xX](?:[0-9a-fA-F]*\.?[0-9a-fA-F]*)(?:[pP][+-]?[0-9]+)?"
+    r"|(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+)
+_LONG_OPEN = re.compile(r"\[(=*)\[")
+
+
+def _skip_short_string(src: str, i: int) -> int:
+    """Index just after the quoted string starting at ``src[i]`` (or the end of the line)."""
+    quote = src[i]
+    i += 1
+    n = len(src)
+    while i < n:
+        c = src[i]
+        if c == "\\":
+            if src.startswith("z", i + 1):
+                i += 2
+                while i < n and src[i].isspace():
+                    i += 1
+                continue
+            i += 2
+            continue
+        if c == quote:
+            return i + 1
+        if c == "\n":
+            return i  # unfinished string: Lua reports the syntax error itself
+        i += 1
+    return n
+
+
+def _skip_long_bracket(src: str, i: int, level: str) -> int:
+    close = "]" + level + "]"
+    end = src.find(close, i)
+    return len(src) if end < 0 else end + len(close)
+
+
+def mark_tables(source: str) -> str:
+    """Return ``source`` with every table constructor wrapped in ``__fdl_at(line, ...)``.
+
+    Strings, long strings and comments are left untouched; the result has exactly the
+    same number of lines, and each marker carries the 1-based line of its ``{``.
+    """
+    out: list[str] = []
+    closers: list[str] = []  # what each open brace becomes when it closes
+    line = 1
+    i = 0
+    n = len(source)
+    prev = ""  # kind of the previous significant token: "name", "kw", "string", ")", ...
+    while i < n:
+        c = source[i]
+        if c == "\n":
+            line += 1
+            out.append(c)
+            i += 1
+            continue
+        if c.isspace():
+            out.append(c)
+            i += 1
+            continue
+        if source.startswith("--", i):
+            m = _LONG_OPEN.match(source, i + 2)
+            end = _skip_long_bracket(source, m.end(), m.group(1)) if m else source.find("\n", i)
+            end = n if end < 0 else end
+            chunk = source[i:end]
+            line += chunk.count("\n")
+            out.append(chunk)
+            i = end
+            continue
+        if c in "\"'":
+            end = _skip_short_string(source, i)
+        elif c == "[" and (m := _LONG_OPEN.match(source, i)):
+            end = _skip_long_bracket(source, m.end(), m.group(1))
+        else:
+            end = -1
+        if end >= 0:
+            chunk = source[i:end]
+            line += chunk.count("\n")
+            out.append(chunk)
+            i = end
+            prev = "string"
+            continue
+        if m := _NAME.match(source, i):
+            word = m.group()
+            out.append(word)
+            i = m.end()
+            prev = "kw" if word in _KEYWORDS else "name"
+            continue
+        if (c.isdigit() or (c == "." and i + 1 < n and source[i + 1].isdigit())) and (
+            m := _NUMBER.match(source, i)
+        ):
+            out.append(m.group())
+            i = m.end()
+            prev = "number"
+            continue
+        if c == "{":
+            if prev in ("name", "string", ")", "]", "}"):
+                out.append(f"({AT_NAME}({line},{{")
+                closers.append("}))")
+            else:
+                out.append(f"{AT_NAME}({line},{{")
+                closers.append("})")
+            prev = "{"
+            i += 1
+            continue
+        if c == "}":
+            out.append(closers.pop() if closers else "}")
+            prev = "}"
+            i += 1
+            continue
+        out.append(c)
+        prev = c if c in ")]" else "op"
+        i += 1
+    return "".join(out)

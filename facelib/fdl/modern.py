@@ -1,0 +1,394 @@
+"""The modern FDL syntax: storyboard functions a writer calls (see ``docs/fdl.md``).
+
+``say``, ``show``, ``look``, ``define_expression`` and ``define_gaze`` each take one table
+(``say`` also a plain string). The sandbox records the calls with their lines; this module
+validates them and turns them into timed cues. Times are seconds or unit strings (see
+:mod:`facelib.fdl.timing`); a cue without ``at`` starts where the previous cue of its kind
+ended.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from facelib.errors import FdlError
+from facelib.fdl.context import Context
+from facelib.fdl.suggest import did_you_mean
+from facelib.fdl.timing import parse_time
+from facelib.fdl.values import LuaTable, lua_kind
+from facelib.mpeg4.tables import fap_table
+
+__all__ = ["FUNCTIONS", "DraftCue", "DraftSpeech", "ModernParts", "read_calls"]
+
+FUNCTIONS = ("say", "show", "look", "define_expression", "define_gaze")
+"""The storyboard functions of the modern syntax."""
+
+_SHOW_FIELDS = ("at", "dur", "intensity", "ease_in", "ease_out")
+_LOOK_FIELDS = ("at", "dur")
+_SAY_FIELDS = ("text", "transcript", "audio", "visemes", "at")
+_MAX_FAP_VALUE = 100_000.0
+
+
+@dataclass(frozen=True, slots=True)
+class DraftCue:
+    """An expression or gaze cue whose start may still be open (``at_ms`` None)."""
+
+    name: str
+    args: tuple[str | float, ...]
+    at_ms: int | None
+    duration_ms: int
+    line: int | None
+    intensity: float = 1.0
+    ramp_in_ms: int | None = None
+    ramp_out_ms: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class DraftSpeech:
+    """A ``say`` call: files still unresolved; visemes as (name, duration_ms, line)."""
+
+    line: int | None
+    at_ms: int
+    text: str | None = None
+    transcript: str | None = None
+    audio: str | None = None
+    visemes: tuple[tuple[str, int, int | None], ...] | None = None
+
+
+@dataclass(slots=True)
+class ModernParts:
+    """Everything the storyboard-function calls asked for, in call order."""
+
+    speech: DraftSpeech | None = None
+    expressions: list[DraftCue] = field(default_factory=list)
+    gaze: list[DraftCue] = field(default_factory=list)
+    expression_defs: dict[str, Mapping[str, float]] = field(default_factory=dict)
+    expression_mixes: dict[str, Mapping[str, float]] = field(default_factory=dict)
+    gaze_defs: dict[str, Mapping[str, Any]] = field(default_factory=dict)
+
+
+def read_calls(calls: list[tuple[str, Any, int | None, int]], ctx: Context) -> ModernParts:
+    """Validate recorded calls ``(function, argument, line, n_arguments)`` into parts."""
+    parts = ModernParts()
+    readers = {
+        "say": _say,
+        "show": _show,
+        "look": _look,
+        "define_expression": _define_expression,
+        "define_gaze": _define_gaze,
+    }
+    for name, arg, line, n_args in calls:
+        if n_args != 1:
+            raise FdlError(
+                f"{name} takes one table, like {name} {{ ... }}; got {n_args} arguments",
+                path=ctx.path,
+                line=line,
+            )
+        readers[name](arg, ctx, line, parts)
+    return parts
+
+
+def _table(
+    arg: object, fn: str, ctx: Context, line: int | None, *, allowed: tuple[str, ...]
+) -> LuaTable:
+    if not isinstance(arg, LuaTable):
+        raise FdlError(
+            f'{fn} takes a table, like {fn} {{ "name", ... }}; got a {lua_kind(arg)} {arg!r}',
+            path=ctx.path,
+            line=line,
+        )
+    for key in arg.fields:
+        if key not in allowed:
+            raise FdlError(
+                f"{fn}: unknown field {key!r}{did_you_mean(key, allowed)}"
+                f" (fields: {', '.join(allowed)})",
+                path=ctx.path,
+                line=line,
+            )
+    return arg
+
+
+def _name(arg: LuaTable, fn: str, ctx: Context, line: int | None) -> str:
+    if not arg.items or not isinstance(arg.items[0], str) or not arg.items[0].strip():
+        raise FdlError(
+            f'{fn} needs a name first, like {fn} {{ "joy", ... }}', path=ctx.path, line=line
+        )
+    return arg.items[0]
+
+
+def _time(value: object, what: str, ctx: Context, line: int | None) -> int:
+    return parse_time(value, fps=ctx.fps, what=what, path=ctx.path, line=line)
+
+
+def _opt_time(
+    fields: dict[str, Any], key: str, fn: str, ctx: Context, line: int | None
+) -> int | None:
+    return None if key not in fields else _time(fields[key], f"{fn}: {key}", ctx, line)
+
+
+def _show(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+    t = _table(arg, "show", ctx, line, allowed=_SHOW_FIELDS)
+    name = _name(t, "show", ctx, line)
+    if len(t.items) > 1:
+        raise FdlError(
+            f"show {{ {name!r}, ... }}: unexpected value {t.items[1]!r} after the name; "
+            "give times and intensity as named fields (at = ..., dur = ...)",
+            path=ctx.path,
+            line=line,
+        )
+    if "dur" not in t.fields:
+        raise FdlError(f"show {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
+    duration = _time(t.fields["dur"], "show: dur", ctx, line)
+    intensity = t.fields.get("intensity", 1.0)
+    if (
+        isinstance(intensity, bool)
+        or not isinstance(intensity, int | float)
+        or not (0.0 <= intensity <= 1.0)
+    ):
+        raise FdlError(
+            f"show: intensity must be a number from 0 to 1; got {intensity!r}",
+            path=ctx.path,
+            line=line,
+        )
+    ease_in = _opt_time(t.fields, "ease_in", "show", ctx, line)
+    ease_out = _opt_time(t.fields, "ease_out", "show", ctx, line)
+    if (ease_in or 0) + (ease_out or 0) > duration:
+        raise FdlError(
+            f"show {{ {name!r} }}: ease_in + ease_out ({(ease_in or 0) + (ease_out or 0)} ms) "
+            f"is longer than dur ({duration} ms)",
+            path=ctx.path,
+            line=line,
+        )
+    parts.expressions.append(
+        DraftCue(
+            name=name,
+            args=(),
+            at_ms=_opt_time(t.fields, "at", "show", ctx, line),
+            duration_ms=duration,
+            line=line,
+            intensity=float(intensity),
+            ramp_in_ms=ease_in,
+            ramp_out_ms=ease_out,
+        )
+    )
+
+
+def _look(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+    t = _table(arg, "look", ctx, line, allowed=_LOOK_FIELDS)
+    name = _name(t, "look", ctx, line)
+    if "dur" not in t.fields:
+        raise FdlError(f"look {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
+    args: list[str | float] = []
+    for value in t.items[1:]:
+        if isinstance(value, bool) or not isinstance(value, str | int | float):
+            raise FdlError(
+                f"look {{ {name!r} }}: value {value!r} must be a string or a number",
+                path=ctx.path,
+                line=line,
+            )
+        args.append(value if isinstance(value, str) else float(value))
+    parts.gaze.append(
+        DraftCue(
+            name=name,
+            args=tuple(args),
+            at_ms=_opt_time(t.fields, "at", "look", ctx, line),
+            duration_ms=_time(t.fields["dur"], "look: dur", ctx, line),
+            line=line,
+        )
+    )
+
+
+def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+    if parts.speech is not None:
+        raise FdlError(
+            f"say is called a second time (the first call is on line {parts.speech.line}); "
+            "a storyboard has one speech",
+            path=ctx.path,
+            line=line,
+        )
+    if isinstance(arg, str):
+        parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
+        return
+    t = _table(arg, "say", ctx, line, allowed=_SAY_FIELDS)
+    f = t.fields
+    if len(t.items) > 1 or (t.items and not isinstance(t.items[0], str)):
+        raise FdlError(
+            "say takes the spoken text first, then named fields (audio = ..., at = ...)",
+            path=ctx.path,
+            line=line,
+        )
+    text = t.items[0] if t.items else f.get("text")
+    if t.items and "text" in f:
+        raise FdlError(
+            "say: the text is given twice (first value and text =)", path=ctx.path, line=line
+        )
+    if text is not None and "transcript" in f:
+        raise FdlError(
+            "say: give either the text or a transcript file, not both", path=ctx.path, line=line
+        )
+    for key in ("text", "transcript", "audio"):
+        if key in f and not isinstance(f[key], str):
+            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
+    visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
+    if text is None and "transcript" not in f and "audio" not in f and visemes is None:
+        raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
+    parts.speech = DraftSpeech(
+        line=line,
+        at_ms=_opt_time(f, "at", "say", ctx, line) or 0,
+        text=text,
+        transcript=f.get("transcript"),
+        audio=f.get("audio"),
+        visemes=visemes,
+    )
+
+
+def _visemes(
+    value: object, ctx: Context, line: int | None
+) -> tuple[tuple[str, int, int | None], ...]:
+    if not isinstance(value, LuaTable) or value.fields:
+        raise FdlError(
+            'say: visemes must be a list like { {"sil", 0.2}, {"aa", "120ms"} }',
+            path=ctx.path,
+            line=line,
+        )
+    out = []
+    for index, entry in enumerate(value.items, start=1):
+        where = entry.line if isinstance(entry, LuaTable) and entry.line else line
+        if (
+            not isinstance(entry, LuaTable)
+            or entry.fields
+            or len(entry.items) != 2
+            or not isinstance(entry.items[0], str | int)
+            or isinstance(entry.items[0], bool)
+        ):
+            raise FdlError(
+                f"say: visemes[{index}] must be {{viseme, duration}}; got {entry!r}",
+                path=ctx.path,
+                line=where,
+            )
+        name, duration = entry.items
+        out.append((str(name), _time(duration, f"visemes[{index}] duration", ctx, where), where))
+    return tuple(out)
+
+
+def _define_expression(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+    if not isinstance(arg, LuaTable):
+        _table(arg, "define_expression", ctx, line, allowed=())
+    t: LuaTable = arg  # type: ignore[assignment]
+    name = _name(t, "define_expression", ctx, line)
+    if len(t.items) > 1:
+        raise FdlError(
+            f"define_expression {{ {name!r} }}: give FAP values as named fields "
+            "(raise_l_cornerlip_o = 120)",
+            path=ctx.path,
+            line=line,
+        )
+    valid = {f.name: f for f in fap_table() if f.kind != "special"}
+    values: dict[str, float] = {}
+    mix: dict[str, float] = {}
+    for key, value in t.fields.items():
+        if key == "mix":
+            mix = _mix(value, name, ctx, line)
+            continue
+        if key not in valid:
+            raise FdlError(
+                f"define_expression {{ {name!r} }}: {key!r} is not a FAP name"
+                f"{did_you_mean(key, [*valid, 'mix'])}",
+                path=ctx.path,
+                line=ctx.line_of(key, after=line) or line,
+            )
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not (math.isfinite(value) and abs(value) <= _MAX_FAP_VALUE)
+        ):
+            raise FdlError(
+                f"define_expression {{ {name!r} }}: {key} must be a FAP value (a number); "
+                f"got {value!r}",
+                path=ctx.path,
+                line=line,
+            )
+        values[key] = float(value)
+    local = {
+        k: v
+        for k, v in mix.items()
+        if k in parts.expression_defs and k not in parts.expression_mixes
+    }
+    if mix and len(local) == len(mix):
+        combined: dict[str, float] = {}
+        for component, weight in mix.items():
+            for fap_name, v in parts.expression_defs[component].items():
+                combined[fap_name] = combined.get(fap_name, 0.0) + weight * v
+        values = {**combined, **values}
+        mix = {}
+    parts.expression_defs[name] = MappingProxyType(values)
+    if mix:
+        parts.expression_mixes[name] = MappingProxyType(mix)
+    else:
+        parts.expression_mixes.pop(name, None)
+
+
+def _mix(value: object, name: str, ctx: Context, line: int | None) -> dict[str, float]:
+    if not isinstance(value, LuaTable) or value.items or not value.fields:
+        raise FdlError(
+            f"define_expression {{ {name!r} }}: mix must map expression names to weights, "
+            "like mix = { joy = 0.5, sadness = 0.5 }",
+            path=ctx.path,
+            line=line,
+        )
+    out = {}
+    for component, weight in value.fields.items():
+        if (
+            isinstance(weight, bool)
+            or not isinstance(weight, int | float)
+            or not (math.isfinite(weight) and abs(weight) <= 10.0)
+        ):
+            raise FdlError(
+                f"define_expression {{ {name!r} }}: mix weight of {component!r} must be a "
+                f"number from -10 to 10; got {weight!r}",
+                path=ctx.path,
+                line=line,
+            )
+        if component == name:
+            raise FdlError(
+                f"define_expression {{ {name!r} }}: an expression cannot mix itself",
+                path=ctx.path,
+                line=line,
+            )
+        out[component] = float(weight)
+    return out
+
+
+def _define_gaze(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+    if not isinstance(arg, LuaTable):
+        _table(arg, "define_gaze", ctx, line, allowed=())
+    t: LuaTable = arg  # type: ignore[assignment]
+    name = _name(t, "define_gaze", ctx, line)
+    if len(t.items) > 1:
+        raise FdlError(
+            f"define_gaze {{ {name!r} }}: give parameters as named fields (rate = 2.0)",
+            path=ctx.path,
+            line=line,
+        )
+    params: dict[str, Any] = {}
+    for key, value in t.fields.items():
+        if isinstance(value, str | bool | int | float):
+            params[key] = value if isinstance(value, str | bool) else float(value)
+        elif (
+            isinstance(value, LuaTable)
+            and not value.fields
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value.items)
+        ):
+            params[key] = tuple(float(v) for v in value.items)
+        else:
+            raise FdlError(
+                f"define_gaze {{ {name!r} }}: parameter {key} must be a string, number, "
+                f"boolean or list of numbers; got a {lua_kind(value)}",
+                path=ctx.path,
+                line=ctx.line_of(key, after=line) or line,
+            )
+    parts.gaze_defs[name] = MappingProxyType(params)

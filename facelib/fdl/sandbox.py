@@ -1,0 +1,213 @@
+"""The sandboxed Lua 5.4 runtime that runs FDL scripts.
+
+An ``.fdl`` file is untrusted code. :class:`Sandbox` runs it in ``lupa.lua54`` with:
+
+- no Python builtins, no ``python.eval``, an attribute filter that refuses every Python
+  attribute, and no Python object reachable from user code (host callables are upvalues
+  of trusted Lua closures only);
+- a fresh environment table per chunk holding a whitelist: ``string`` (without ``dump``,
+  pattern functions bounded), ``table``, ``math`` (``math.random`` seeded from the
+  storyboard seed, no ``randomseed``), ``utf8``, ``pairs``, ``ipairs``, ``select``,
+  ``type``, ``tostring``, ``tonumber``, ``error``, ``pcall``, ``assert`` and a ``print``
+  (kept in :attr:`Sandbox.printed`; the loader passes it to the ``facelib.fdl`` logger),
+  plus the storyboard functions the caller names;
+- chunks compiled from text only (mode ``"t"``) under their file name;
+- a memory cap (``max_memory``) and an instruction budget enforced by a count hook that
+  the host installs before user code runs; user ``pcall`` cannot catch either limit;
+- the string metatable's ``__index`` pointing to the sandbox's own ``string`` copy.
+
+Every failure is raised as :class:`~facelib.errors.FdlError` with the file and line; the
+sandbox stays usable afterwards.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from importlib import resources
+from typing import Any
+
+from facelib.errors import FdlError
+from facelib.fdl.marking import mark_tables
+from facelib.fdl.suggest import did_you_mean
+
+__all__ = [
+    "DEFAULT_MAX_INSTRUCTIONS",
+    "DEFAULT_MAX_MEMORY",
+    "WHITELIST",
+    "ChunkResult",
+    "Sandbox",
+]
+
+DEFAULT_MAX_MEMORY = 64 * 1024 * 1024
+"""Bytes the whole Lua state may hold (64 MiB)."""
+DEFAULT_MAX_INSTRUCTIONS = 100_000_000
+"""Lua VM instructions one chunk may execute (well under a second of pure Lua on a laptop core)."""
+MAX_SOURCE_BYTES = 1024 * 1024
+"""Largest script text accepted (1 MiB)."""
+_MAX_PRINT_CHARS = 2000
+
+WHITELIST = (
+    "string", "table", "math", "utf8", "pairs", "ipairs", "select", "type", "tostring",
+    "tonumber", "error", "pcall", "assert", "print",
+)  # fmt: skip
+"""Globals every chunk gets, besides the storyboard functions the caller names."""
+
+
+def _refuse_attribute(obj: object, name: object, is_setting: bool) -> str:
+    raise AttributeError(f"access to Python attribute {name!r} is not allowed in FDL")
+
+
+@dataclass(frozen=True, slots=True)
+class ChunkResult:
+    """What one chunk left behind.
+
+    ``env`` is the chunk's global table, ``lines`` a weak map from each table the chunk
+    constructed to the 1-based line of its ``{``, and ``calls`` the storyboard-function
+    calls in order as Lua tables ``{name, first_argument, line, n_arguments}``.
+    ``instructions`` counts the VM instructions used (in steps of 1000).
+    """
+
+    path: str
+    env: Any
+    lines: Any
+    calls: Any
+    instructions: int
+
+
+class Sandbox:
+    """A reusable sandboxed Lua 5.4 state.
+
+    Parameters
+    ----------
+    max_memory: bytes the Lua state may allocate in all.
+    max_instructions: VM instructions one chunk may execute.
+    """
+
+    def __init__(
+        self,
+        *,
+        max_memory: int = DEFAULT_MAX_MEMORY,
+        max_instructions: int = DEFAULT_MAX_INSTRUCTIONS,
+    ) -> None:
+        if max_memory < 1024 * 1024:
+            raise FdlError(f"max_memory={max_memory} is below the 1 MiB a Lua state needs")
+        if max_instructions < 1000:
+            raise FdlError(f"max_instructions={max_instructions} is below 1000")
+        self.max_memory = int(max_memory)
+        self.max_instructions = int(max_instructions)
+        self.printed: list[str] = []
+        self._start()
+
+    def _start(self) -> None:
+        from lupa import lua54
+
+        self._lupa = lua54
+        self._lua = lua54.LuaRuntime(
+            register_eval=False,
+            register_builtins=False,
+            unpack_returned_tuples=True,
+            attribute_filter=_refuse_attribute,
+            max_memory=self.max_memory,
+        )
+        boot = resources.files("facelib.data").joinpath("fdl/sandbox.lua").read_text("utf-8")
+        # The bootstrap needs the standard library, so it runs without the memory cap.
+        self._run, self._collect = self._lua.execute(
+            boot, self._print, name="=fdl-sandbox", mode="t"
+        )
+
+    def _print(self, text: object) -> None:
+        message = str(text)
+        if len(message) > _MAX_PRINT_CHARS:
+            message = message[:_MAX_PRINT_CHARS] + "..."
+        self.printed.append(message)
+
+    def run(
+        self,
+        source: str,
+        *,
+        path: str,
+        seed: int = 0,
+        functions: tuple[str, ...] = (),
+    ) -> ChunkResult:
+        """Run ``source`` (the text of file ``path``) and return what it left behind.
+
+        ``functions`` names the storyboard functions (recorders) to expose as globals.
+        Raises FdlError with ``path`` and the line for syntax errors, runtime errors,
+        exceeded memory and exceeded instruction budget.
+        """
+        if "\0" in source:
+            raise FdlError("script contains a NUL character", path=path)
+        if len(source.encode("utf-8", "surrogatepass")) > MAX_SOURCE_BYTES:
+            raise FdlError(f"script is larger than {MAX_SOURCE_BYTES} bytes", path=path)
+        short = _chunk_short_name(path)
+        marked = f"local __fdl_at = ...; {mark_tables(source)}"
+        api = self._lua.table_from(list(functions))
+        lua_seed = int(seed) % (1 << 63)
+        try:
+            result = self._run(source, marked, "@" + short, self.max_instructions, lua_seed, api)
+        except self._lupa.LuaMemoryError:
+            self._restart()
+            raise FdlError(
+                f"script exceeded the sandbox memory limit ({self.max_memory} bytes)", path=path
+            ) from None
+        except self._lupa.LuaError as exc:  # trusted code failed: start afresh
+            self._restart()
+            raise FdlError(f"script failed in the sandbox: {exc}", path=path) from None
+        if result[0]:
+            _, env, lines, calls, used = result
+            return ChunkResult(path=path, env=env, lines=lines, calls=calls, instructions=used)
+        _, kind, message, line, _used = result
+        raise _error(kind, str(message), line, path=path, short=short, limits=self)
+
+    def _restart(self) -> None:
+        self._start()
+
+    def collect(self) -> None:
+        """Free what finished chunks left (called by the loader between chunks)."""
+        self._collect()
+
+
+def _chunk_short_name(path: str) -> str:
+    name = path.replace("\\", "/").rsplit("/", 1)[-1] or "script"
+    return name[-50:]
+
+
+_WHERE = re.compile(r"^(?P<src>[^\n]*?):(?P<line>\d+): (?P<msg>.*)$", re.DOTALL)
+_GLOBAL = re.compile(r"\((?:global|field) '([A-Za-z_][A-Za-z0-9_]*)'\)")
+
+
+def _error(
+    kind: str, message: str, line: int, *, path: str, short: str, limits: Sandbox
+) -> FdlError:
+    where = None if line is None or line < 1 else int(line)
+    if kind == "instructions":
+        return FdlError(
+            f"script ran past the instruction budget ({limits.max_instructions} Lua "
+            "instructions); is there an endless loop?",
+            path=path,
+            line=where,
+        )
+    if kind == "memory":
+        return FdlError(
+            f"script exceeded the sandbox memory limit ({limits.max_memory} bytes)",
+            path=path,
+            line=where,
+        )
+    m = _WHERE.match(message)
+    if (m and m.group("src") in (short, f"...{short[-40:]}")) or (
+        m and m.group("src").endswith(short[-20:])
+    ):
+        where = int(m.group("line"))
+        message = m.group("msg")
+    if kind == "syntax":
+        return FdlError(f"syntax error: {message}", path=path, line=where)
+    g = _GLOBAL.search(message)
+    if g and ("call" in message or "index" in message):
+        message += did_you_mean(g.group(1), (*WHITELIST, *_STORYBOARD_FUNCTIONS))
+    return FdlError(message, path=path, line=where)
+
+
+_STORYBOARD_FUNCTIONS: tuple[str, ...] = (
+    "say", "show", "look", "define_expression", "define_gaze",
+)  # fmt: skip

@@ -1,0 +1,108 @@
+"""Lua values left by a script, copied into plain Python with the line of each table.
+
+:func:`to_python` turns a Lua table into a :class:`LuaTable` (its array part, its named
+fields and the 1-based source line of its ``{``), recursively. Strings, numbers, booleans
+and nil come through as ``str``, ``int``/``float``, ``bool`` and ``None``; functions and
+other Lua values become :class:`Opaque` so validation can name them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from facelib.errors import FdlError
+
+__all__ = ["LuaTable", "Opaque", "to_python"]
+
+_MAX_DEPTH = 32
+_MAX_NODES = 1_000_000
+
+
+@dataclass(frozen=True, slots=True)
+class Opaque:
+    """A Lua value with no data meaning here (a function, ...): ``kind`` is its Lua type."""
+
+    kind: str
+
+
+@dataclass(frozen=True, slots=True)
+class LuaTable:
+    """A Lua table: ``items`` holds keys 1..n in order, ``fields`` the string keys,
+    ``line`` the line of its constructor (None when no constructor made it)."""
+
+    items: tuple[Any, ...] = ()
+    fields: dict[str, Any] = field(default_factory=dict)
+    line: int | None = None
+
+
+def lua_kind(value: Any) -> str:
+    """The Lua type name of a converted value (for error messages)."""
+    if value is None:
+        return "nil"
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, int | float):
+        return "number"
+    if isinstance(value, str):
+        return "string"
+    if isinstance(value, LuaTable):
+        return "table"
+    if isinstance(value, Opaque):
+        return value.kind
+    return type(value).__name__
+
+
+def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> Any:
+    """Copy ``value`` (a lupa value) into plain Python.
+
+    ``lines`` is the sandbox's table -> line map. Tables nested deeper than 32 levels
+    (or cyclic), or more than a million values in all, raise FdlError.
+    """
+    from lupa import lua54
+
+    count = [0]
+
+    def convert(v: Any, depth: int, where: int | None) -> Any:
+        count[0] += 1
+        if count[0] > _MAX_NODES:
+            raise FdlError(f"script left more than {_MAX_NODES} values", path=path, line=where)
+        if v is None or isinstance(v, bool | int | float | str):
+            return v
+        if isinstance(v, bytes):
+            raise FdlError("a string is not valid UTF-8", path=path, line=where)
+        kind = lua54.lua_type(v)
+        if kind != "table":
+            return Opaque(kind or type(v).__name__)
+        own = lines[v]
+        here = int(own) if isinstance(own, int) else where
+        if depth >= _MAX_DEPTH:
+            raise FdlError(
+                f"tables nested deeper than {_MAX_DEPTH} levels (a cycle?)", path=path, line=here
+            )
+        numbered: dict[int, Any] = {}
+        named: dict[str, Any] = {}
+        for key, item in v.items():
+            if isinstance(key, bool) or not isinstance(key, int | str):
+                raise FdlError(
+                    f"table key {key!r} is neither a name nor a position", path=path, line=here
+                )
+            if isinstance(key, int):
+                numbered[key] = convert(item, depth + 1, here)
+            else:
+                named[key] = convert(item, depth + 1, here)
+        n = len(numbered)
+        if numbered and set(numbered) != set(range(1, n + 1)):
+            gaps = sorted(set(range(1, max(numbered) + 1)) - set(numbered))[:3]
+            raise FdlError(
+                f"table has holes in its list part (missing positions {gaps})",
+                path=path,
+                line=here,
+            )
+        items = tuple(numbered[i] for i in range(1, n + 1))
+        return LuaTable(items=items, fields=named, line=here if own is not None else None)
+
+    try:
+        return convert(value, 0, line)
+    except UnicodeDecodeError:
+        raise FdlError("a string is not valid UTF-8", path=path, line=line) from None
