@@ -74,9 +74,9 @@ def animate(
     )
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
                         behaviours=storyboard.gaze_defs, speaking=speaking)
-    stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.track,
-                     blinks=getattr(eyes, "blinks", None), speaking=speaking, rules=rules,
-                     seed=storyboard.seed)
+    stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
+                     blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=speaking,
+                     rules=rules, seed=storyboard.seed)
     return Animation(
         faps=stream,
         audio=storyboard.speech.audio if storyboard.speech else None,

@@ -25,8 +25,6 @@ HEAD_FAPS = tuple(fap(name).index for name in ("head_pitch", "head_yaw", "head_r
 """Columns of FAP 48-50."""
 _UPPER_LIDS = (fap("close_t_l_eyelid").index, fap("close_t_r_eyelid").index)
 _LOWER_LIDS = (fap("close_b_l_eyelid").index, fap("close_b_r_eyelid").index)
-_LID_CLOSED = 1024.0  # IRISD units: the lid travels one iris diameter
-_LOWER_LID_CLOSED = 150.0  # in a blink the lower lid rises a little (IRISD units)
 
 
 def blend(a: FapTrack, b: FapTrack, *, weight_a: float, weight_b: float) -> FapTrack:
@@ -47,16 +45,18 @@ def blend(a: FapTrack, b: FapTrack, *, weight_a: float, weight_b: float) -> FapT
     return FapTrack(a.fps, values.astype(np.float32), np.maximum(a.weight, b.weight))
 
 
-def close_lids(track: FapTrack, closure: np.ndarray) -> FapTrack:
-    """Blinks: move the upper lids ``closure`` (``(n_frames,)`` in [0, 1]) of the way from
-    where they are to fully closed, the lower lids a little; 1 closes the eye whatever an
-    expression or gaze asked of the lids."""
+def close_lids(
+    track: FapTrack, closure: np.ndarray, *, closed: tuple[float, float] = (1024.0, 0.0)
+) -> FapTrack:
+    """Blinks: move the lids ``closure`` (``(n_frames,)`` in [0, 1]) of the way from where
+    they are to ``closed`` (upper, lower lid values in IRISD units; 1024 is a full upper-lid
+    travel); 1 closes the eye whatever an expression or gaze asked of the lids."""
     closure = np.asarray(closure, np.float64)[:, None]
     values = track.values.astype(np.float64)
     weight = track.weight.copy()
-    for columns, target in ((_UPPER_LIDS, _LID_CLOSED), (_LOWER_LIDS, _LOWER_LID_CLOSED)):
+    for columns, target in zip((_UPPER_LIDS, _LOWER_LIDS), closed, strict=True):
         cols = list(columns)
-        values[:, cols] += closure * np.maximum(target - values[:, cols], 0.0)
+        values[:, cols] += closure * np.maximum(target - values[:, cols], 0.0)  # never opens
         weight[:, cols] = np.maximum(weight[:, cols], (closure > 0).astype(np.float32))
     return FapTrack(track.fps, values.astype(np.float32), weight)
 
@@ -112,20 +112,23 @@ def combine(
     visemes: FapTrack,
     gaze: FapTrack,
     blinks: np.ndarray | None = None,
+    blink_lids: tuple[float, float] = (1024.0, 0.0),
     speaking: np.ndarray | None = None,
     rules: SyncRules | None = None,
     seed: int = 0,
 ) -> FapStream:
     """Resolve the three generators' tracks (all of one length and fps) into a stream.
 
-    blinks: ``(n_frames,)`` lid closure in [0, 1] from the eye-behaviour model, or None.
+    gaze: the eye track with its lids open (blinks are applied after the lid blend).
+    blinks: ``(n_frames,)`` lid closure in [0, 1] from the eye-behaviour model, or None;
+    blink_lids: the (upper, lower) lid values at full closure.
     speaking: ``(n_frames,) bool`` where the character talks (livelier head noise).
     """
     rules = rules or SyncRules.load()
     face = blend(expressions, visemes, weight_a=rules.mouth[0], weight_b=rules.mouth[1])
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
     if blinks is not None:
-        face = close_lids(face, blinks)
+        face = close_lids(face, blinks, closed=blink_lids)
     if rules.head_noise is not None:
         head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
         face = add_head_noise(face, noise=rules.head_noise, seed=seed,

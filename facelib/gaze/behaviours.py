@@ -1,0 +1,338 @@
+"""Eye behaviours as parameter sets over the statistical model, and binding of eye-script
+tuples (``{"discomfort", 0.99, 0.6, 500}``) to them.
+
+The library is ``facelib/data/gaze/behaviours.json``; storyboards add or override
+behaviours with plain mappings of the same shape (see ``docs/gaze.md``).
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import json
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from typing import Any
+
+from facelib.errors import FdlError
+from facelib.gaze.model import GAZE_MODES, mode_stats
+
+__all__ = [
+    "DIRECTION_NAMES",
+    "BoundBehaviour",
+    "behaviour_library",
+    "bind_behaviour",
+    "merge_behaviours",
+]
+
+ENGINES = ("statistical", "look", "pursuit")
+ARG_KINDS = ("choice", "number", "yesno", "direction")
+_NUMERIC = (
+    "magnitude_scale",
+    "magnitude_max_deg",
+    "p_mutual",
+    "interval_scale",
+    "lid_closure",
+    "blink_scale",
+    "head_coupling",
+    "head_threshold_deg",
+)
+_PAIRS = ("gaze_offset_deg", "head_offset_deg")
+PARAM_KEYS = ("engine", "mode", "direction_percent", *_NUMERIC, *_PAIRS)
+_SLOTS = ("p_away", "intensity", "direction", "angle", "head")
+_BEHAVIOUR_KEYS = ("description", "args", "params", "base")
+
+
+@cache
+def _library_json() -> dict[str, Any]:
+    text = resources.files("facelib.data").joinpath("gaze/behaviours.json").read_text("utf-8")
+    return json.loads(text)
+
+
+def behaviour_library() -> dict[str, dict[str, Any]]:
+    """A fresh copy of the built-in behaviours: name -> {description, args, params}."""
+    return {k: copy.deepcopy(v) for k, v in _library_json().items() if not k.startswith("_")}
+
+
+def _direction_names() -> dict[str, float | None]:
+    return dict(_library_json()["_directions"])
+
+
+DIRECTION_NAMES = tuple(_direction_names())
+
+
+def _suggest(word: str, options: Sequence[str]) -> str:
+    close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
+    if close:
+        return f"; did you mean {close[0]!r}?"
+    return f"; expected one of {', '.join(repr(o) for o in options)}"
+
+
+def merge_behaviours(
+    overrides: Mapping[str, Mapping[str, Any]] | None,
+) -> dict[str, dict[str, Any]]:
+    """The built-in library with storyboard behaviours merged over it.
+
+    An override of an existing name replaces the keys it gives (``params`` key by key); a new
+    name starts from ``base`` (default ``"default"``). Raises :class:`FdlError` naming the
+    behaviour and key for anything malformed.
+    """
+    library = behaviour_library()
+    for name, spec in (overrides or {}).items():
+        if not isinstance(spec, Mapping):
+            raise FdlError(f"eye behaviour {name!r} must be a table, got {spec!r}")
+        for key in spec:
+            if key not in _BEHAVIOUR_KEYS and key not in PARAM_KEYS:
+                raise FdlError(
+                    f"eye behaviour {name!r}: unknown key {key!r}"
+                    + _suggest(str(key), (*_BEHAVIOUR_KEYS, *PARAM_KEYS))
+                )
+        base_name = spec.get("base", name if name in library else "default")
+        if base_name not in library:
+            raise FdlError(
+                f"eye behaviour {name!r}: unknown base {base_name!r}"
+                + _suggest(str(base_name), sorted(library))
+            )
+        merged = copy.deepcopy(library[base_name])
+        params = dict(merged.get("params", {}))
+        params.update(spec.get("params", {}))
+        params.update({k: v for k, v in spec.items() if k in PARAM_KEYS})
+        merged["params"] = params
+        if "args" in spec:
+            merged["args"] = [dict(a) for a in spec["args"]]
+        if "description" in spec:
+            merged["description"] = str(spec["description"])
+        _validate(str(name), merged)
+        library[str(name)] = merged
+    return library
+
+
+def _validate(name: str, spec: Mapping[str, Any]) -> None:
+    params = spec.get("params", {})
+    for key, value in params.items():
+        if key not in PARAM_KEYS:
+            raise FdlError(
+                f"eye behaviour {name!r}: unknown parameter {key!r}" + _suggest(key, PARAM_KEYS)
+            )
+        if key in _NUMERIC and value is not None:
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise FdlError(
+                    f"eye behaviour {name!r}: {key} must be a number >= 0, got {value!r}"
+                )
+            if key == "p_mutual" and value > 1:
+                raise FdlError(f"eye behaviour {name!r}: p_mutual must be <= 1, got {value!r}")
+    if params.get("engine", "statistical") not in ENGINES:
+        raise FdlError(
+            f"eye behaviour {name!r}: engine {params['engine']!r}"
+            + _suggest(str(params["engine"]), ENGINES)
+        )
+    if "mode" in params and params["mode"] not in (*GAZE_MODES, "auto"):
+        raise FdlError(
+            f"eye behaviour {name!r}: mode {params['mode']!r}"
+            + _suggest(str(params["mode"]), (*GAZE_MODES, "auto"))
+        )
+    percent = params.get("direction_percent")
+    if percent is not None and (
+        len(percent) != 8
+        or any(not isinstance(p, (int, float)) or p < 0 for p in percent)
+        or sum(percent) <= 0
+    ):
+        raise FdlError(
+            f"eye behaviour {name!r}: direction_percent must be 8 numbers >= 0, got {percent!r}"
+        )
+    for key in _PAIRS:
+        pair = params.get(key)
+        if pair is not None and (
+            len(pair) != 2 or not all(isinstance(v, (int, float)) for v in pair)
+        ):
+            raise FdlError(
+                f"eye behaviour {name!r}: {key} must be [left, up] degrees, got {pair!r}"
+            )
+    for arg in spec.get("args", []):
+        if arg.get("kind") not in ARG_KINDS:
+            raise FdlError(
+                f"eye behaviour {name!r}: argument kind {arg.get('kind')!r}"
+                + _suggest(str(arg.get("kind")), ARG_KINDS)
+            )
+        if arg.get("sets") not in (*PARAM_KEYS, *_SLOTS):
+            raise FdlError(
+                f"eye behaviour {name!r}: argument sets {arg.get('sets')!r}"
+                + _suggest(str(arg.get("sets")), (*PARAM_KEYS, *_SLOTS))
+            )
+
+
+@dataclass(frozen=True, slots=True)
+class BoundBehaviour:
+    """An eye behaviour with its script arguments applied, ready to generate.
+
+    engine: ``"statistical"``, ``"look"`` or ``"pursuit"``.
+    mode: talking/listening/thinking, or ``"auto"`` (from where the character speaks).
+    direction_percent: (8,) bin weights or None (the mode's table).
+    magnitude_scale, magnitude_max_deg (None = mode's), p_mutual (None = mode's),
+    interval_scale, lid_closure, blink_scale, head_coupling, head_threshold_deg: see the
+    data file. gaze_offset_deg, head_offset_deg: (left, up) degrees.
+    intensity: blend factor toward ``default`` already applied to the numbers above.
+    target_deg: (left, up) of a look/pursuit target relative to the current gaze origin;
+    head: True if a look/pursuit moves the head.
+    """
+
+    name: str
+    engine: str
+    mode: str
+    direction_percent: tuple[float, ...] | None
+    magnitude_scale: float
+    magnitude_max_deg: float | None
+    p_mutual: float | None
+    interval_scale: float
+    gaze_offset_deg: tuple[float, float]
+    head_offset_deg: tuple[float, float]
+    lid_closure: float
+    blink_scale: float
+    head_coupling: float
+    head_threshold_deg: float
+    target_deg: tuple[float, float] = (0.0, 0.0)
+    head: bool = False
+
+
+def _bind_arg(name: str, arg: Mapping[str, Any], value: Any, where: dict[str, Any]) -> Any:
+    kind, label = arg["kind"], arg["name"]
+    if kind == "number":
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+        ):
+            raise FdlError(f"{name}: {label} must be a number, got {value!r}", **where)
+        lo, hi = arg.get("min", -math.inf), arg.get("max", math.inf)
+        if not lo <= value <= hi:
+            raise FdlError(f"{name}: {label} {value!r} is outside [{lo}, {hi}]", **where)
+        return float(value)
+    if not isinstance(value, (str, int, float)) or isinstance(value, bool):
+        raise FdlError(f"{name}: {label} has the wrong type: {value!r}", **where)
+    if kind == "direction":
+        if isinstance(value, (int, float)):
+            return float(value) % 360.0
+        key = value.lower().replace("-", "").replace("_", "").replace(" ", "")
+        names = _direction_names()
+        if key not in names:
+            raise FdlError(
+                f"{name}: unknown direction {value!r}" + _suggest(key, list(names)), **where
+            )
+        return names[key]
+    text = str(value)
+    if kind == "yesno":
+        if text.lower() not in ("yes", "no"):
+            raise FdlError(f'{name}: {label} must be "yes" or "no", got {value!r}', **where)
+        return text.lower() == "yes"
+    choices = arg["choices"]
+    if text not in choices:
+        raise FdlError(f"{name}: {label} {value!r} is not valid" + _suggest(text, choices), **where)
+    return text
+
+
+def bind_behaviour(
+    name: str,
+    args: Sequence[Any],
+    *,
+    library: Mapping[str, Mapping[str, Any]],
+    origin: tuple[str, int] | None = None,
+) -> BoundBehaviour:
+    """Apply an eye-script tuple's values to behaviour ``name`` of ``library``.
+
+    Raises :class:`FdlError` (with ``origin``'s file and line) for an unknown behaviour,
+    too many values, or a value of the wrong kind or range.
+    """
+    where: dict[str, Any] = {"path": origin[0], "line": origin[1]} if origin else {}
+    if name not in library:
+        raise FdlError(f"unknown eye behaviour {name!r}" + _suggest(name, sorted(library)), **where)
+    spec = library[name]
+    arg_specs = spec.get("args", [])
+    if len(args) > len(arg_specs):
+        names = ", ".join(a["name"] for a in arg_specs) or "none"
+        raise FdlError(
+            f"{name} takes at most {len(arg_specs)} values before the duration ({names}), "
+            f"got {len(args)}: {tuple(args)!r}",
+            **where,
+        )
+    slots: dict[str, Any] = {}
+    for i, arg in enumerate(arg_specs):
+        value = args[i] if i < len(args) else arg.get("default")
+        if value is None:
+            slots[arg["sets"]] = None
+            continue
+        slots[arg["sets"]] = _bind_arg(name, arg, value, where)
+
+    defaults = dict(library["default"]["params"])
+    params = {**defaults, **spec.get("params", {})}
+    for key in PARAM_KEYS:
+        if key in slots:
+            params[key] = slots[key]
+    if "p_away" in slots:
+        params["p_mutual"] = 1.0 - slots["p_away"]
+    intensity = float(slots.get("intensity", 1.0))
+    mode = params["mode"]
+    if intensity != 1.0:
+        blended = _blend(defaults, params, intensity, mode)
+        # Values given directly by the script are not scaled by the intensity.
+        direct = {k for k in PARAM_KEYS if k in slots} | (
+            {"p_mutual"} if "p_away" in slots else set()
+        )
+        params = {k: params[k] if k in direct else blended[k] for k in params}
+    direction = slots.get("direction")
+    angle = float(slots.get("angle", 0.0) or 0.0)
+    if direction is None:
+        target = (0.0, 0.0)
+    else:
+        rad = math.radians(direction)
+        target = (angle * math.cos(rad), angle * math.sin(rad))
+    return BoundBehaviour(
+        name=name,
+        engine=params.get("engine", "statistical"),
+        mode=mode,
+        direction_percent=None
+        if params["direction_percent"] is None
+        else tuple(map(float, params["direction_percent"])),
+        magnitude_scale=float(params["magnitude_scale"]),
+        magnitude_max_deg=None
+        if params["magnitude_max_deg"] is None
+        else float(params["magnitude_max_deg"]),
+        p_mutual=None if params["p_mutual"] is None else float(params["p_mutual"]),
+        interval_scale=max(float(params["interval_scale"]), 1e-3),
+        gaze_offset_deg=(float(params["gaze_offset_deg"][0]), float(params["gaze_offset_deg"][1])),
+        head_offset_deg=(float(params["head_offset_deg"][0]), float(params["head_offset_deg"][1])),
+        lid_closure=float(params["lid_closure"]),
+        blink_scale=float(params["blink_scale"]),
+        head_coupling=float(params["head_coupling"]),
+        head_threshold_deg=float(params["head_threshold_deg"]),
+        target_deg=target,
+        head=bool(slots.get("head", False)),
+    )
+
+
+def _blend(
+    defaults: Mapping[str, Any], params: Mapping[str, Any], t: float, mode: str
+) -> dict[str, Any]:
+    """Numbers of ``params`` moved a fraction ``t`` of the way from ``defaults``; a None
+    (the mode's value) is resolved against ``mode`` first so it can be blended."""
+    stats = mode_stats("talking" if mode == "auto" else mode)
+    resolved_none = {
+        "p_mutual": stats.p_mutual,
+        "magnitude_max_deg": stats.magnitude_max_deg,
+        "direction_percent": list(stats.direction_percent),
+    }
+    out = dict(params)
+    for key in (*_NUMERIC, "direction_percent", *_PAIRS):
+        a = defaults.get(key)
+        b = params.get(key)
+        if a == b:
+            continue
+        a = resolved_none.get(key) if a is None else a
+        b = resolved_none.get(key) if b is None else b
+        if isinstance(a, list | tuple):
+            out[key] = [x + t * (y - x) for x, y in zip(a, b, strict=True)]
+        else:
+            out[key] = a + t * (b - a)
+    return out
