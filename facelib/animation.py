@@ -27,6 +27,7 @@ class Animation:
 
     faps: the synchronized stream (what is rendered or written to ``.fap``).
     audio: the speech audio to play with it, or None.
+    audio_offset: seconds into the animation at which the audio starts.
     storyboard: the storyboard it came from.
     tracks: each generator's own track (``"expressions"``, ``"visemes"``, ``"gaze"``),
         before conflict resolution, for plots and inspection.
@@ -37,6 +38,7 @@ class Animation:
     faps: FapStream
     audio: Path | None
     storyboard: Storyboard
+    audio_offset: float = 0.0
     tracks: Mapping[str, FapTrack] = field(default_factory=dict)
     visemes: Any = None
     gaze_events: Any = ()
@@ -69,7 +71,9 @@ def animate(
         speaking[: speech.speaking.size] = speech.speaking[:n_frames]
     expression_track = expressions.animate(
         storyboard.expressions, fps=fps, n_frames=n_frames,
-        library=expressions.default_library().with_defs(storyboard.expression_defs),
+        library=expressions.default_library().with_defs(
+            storyboard.expression_defs, mixes=storyboard.expression_mixes
+        ),
         importance=rules.expression_importance,
     )
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
@@ -81,6 +85,7 @@ def animate(
         faps=stream,
         audio=storyboard.speech.audio if storyboard.speech else None,
         storyboard=storyboard,
+        audio_offset=storyboard.speech.start_ms / 1000 if storyboard.speech else 0.0,
         tracks={"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track},
         visemes=None if speech is None else speech.timeline,
         gaze_events=eyes.events,

@@ -84,13 +84,36 @@ class ExpressionLibrary:
         raise FdlError(f"unknown expression {name!r}{hint} (known: {', '.join(self.names)})",
                        path=path, line=line)
 
-    def with_defs(self, defs: Mapping[str, Mapping[str | int, float]]) -> ExpressionLibrary:
-        """A library with ``defs`` (name -> {FAP: value}) added or replacing entries."""
-        if not defs:
+    def with_defs(
+        self,
+        defs: Mapping[str, Mapping[str | int, float]],
+        *,
+        mixes: Mapping[str, Mapping[str, float]] | None = None,
+    ) -> ExpressionLibrary:
+        """A library with storyboard definitions added or replacing entries.
+
+        defs: name -> {FAP: value at full intensity}.
+        mixes: name -> {library expression: weight}; the mix is the weighted sum of those
+            expressions, with the FAPs of ``defs[name]`` (if any) set on top.
+        """
+        if not defs and not mixes:
             return self
         merged = dict(self.expressions)
-        for name, faps in defs.items():
+        for name, parts in (mixes or {}).items():
+            values = np.zeros(N_FAPS, np.float64)
+            mask = np.zeros(N_FAPS, bool)
+            for part, weight in parts.items():
+                expression = self.get(part)
+                values += float(weight) * expression.values
+                mask |= expression.mask
+            faps: dict[str | int, float] = {
+                int(i) + 1: float(values[i]) for i in np.flatnonzero(mask)
+            }
+            faps.update(defs.get(name, {}))
             merged[name.lower()] = Expression.from_faps(name.lower(), faps)
+        for name, faps in defs.items():
+            if name not in (mixes or {}):
+                merged[name.lower()] = Expression.from_faps(name.lower(), faps)
         return ExpressionLibrary(MappingProxyType(merged))
 
 

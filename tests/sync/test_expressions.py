@@ -47,6 +47,18 @@ def test_storyboard_definitions_add_and_override():
     assert lib.get("joy").mask.sum() == 1
 
 
+def test_mixes_of_library_expressions_with_faps_on_top():
+    lib = default_library()
+    mixed = lib.with_defs({"bittersweet": {"raise_b_midlip": 20}},
+                          mixes={"bittersweet": {"joy": 0.5, "sadness": 0.5}})
+    got = mixed.get("bittersweet").values
+    for name in ("raise_l_cornerlip", "raise_l_i_eyebrow"):
+        col = fap(name).index
+        expected = 0.5 * lib.get("joy").values[col] + 0.5 * lib.get("sadness").values[col]
+        assert got[col] == pytest.approx(expected)
+    assert got[fap("raise_b_midlip").index] == 20
+
+
 def test_envelope_ramps_linear_and_smooth():
     t = np.arange(0, 1100, 100.0)
     e = envelope(t, start_ms=0, duration_ms=1000, ramp_in_ms=200, ramp_out_ms=400)

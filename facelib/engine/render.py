@@ -1,0 +1,183 @@
+"""Rendering FAP animations of a face: frames in memory, MP4 with speech, GIF, PNG stills.
+
+``render`` plays a :class:`~facelib.mpeg4.stream.FapStream` (or an animation object that
+carries one as ``.faps``, with an optional ``.audio`` path) on a face and returns or writes
+the frames; ``render_still`` renders one pose. OpenGL and pyrender load on first use, on
+the headless platform chosen by :mod:`facelib.engine.render_backend`.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facelib.engine.render_scene import FaceRenderer
+from facelib.engine.video import open_writer, save_png
+from facelib.errors import ParameterError
+from facelib.mpeg4.stream import FapStream
+from facelib.mpeg4.tables import N_FAPS
+
+__all__ = ["iter_frames", "render", "render_still", "save_png", "stream_of"]
+
+_CHUNK = 32  # frames deformed at once: bounds memory to 32 x V x 3 floats
+
+
+def stream_of(source: Any) -> tuple[FapStream, Path | None, float]:
+    """``(stream, audio path or None, audio offset in seconds)`` of a render source.
+
+    ``source`` is a :class:`FapStream` or an object with a ``faps`` FapStream and optional
+    ``audio`` (path) and ``audio_offset`` (seconds) attributes.
+    """
+    if isinstance(source, FapStream):
+        return source, None, 0.0
+    stream = getattr(source, "faps", None)
+    if not isinstance(stream, FapStream):
+        raise ParameterError(
+            f"render needs a FapStream or an animation with a .faps FapStream, got "
+            f"{type(source).__name__}"
+        )
+    audio = getattr(source, "audio", None)
+    return stream, None if audio is None else Path(audio), float(
+        getattr(source, "audio_offset", 0.0) or 0.0
+    )
+
+
+def _default_face(face: Any) -> Any:
+    if face is not None:
+        return face
+    from facelib.engine import load_face
+
+    return load_face(None)
+
+
+def iter_frames(
+    renderer: FaceRenderer, face: Any, stream: FapStream, *, progress: bool = False
+) -> Iterator[np.ndarray]:
+    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``."""
+    bar = None
+    if progress and sys.stderr.isatty():
+        try:
+            from tqdm import tqdm
+        except ImportError:
+            bar = None
+        else:
+            bar = tqdm(total=stream.n_frames, unit="frame", desc="rendering", leave=False)
+    try:
+        for start in range(0, stream.n_frames, _CHUNK):
+            vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
+            for frame_vertices in vertices:
+                yield renderer.frame(frame_vertices)
+                if bar is not None:
+                    bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def render(
+    source: Any,
+    *,
+    face: Any = None,
+    out: str | os.PathLike[str] | None = None,
+    width: int = 640,
+    height: int = 480,
+    audio: str | os.PathLike[str] | None = None,
+    audio_offset: float | None = None,
+    background: Sequence[float] | None = None,
+    progress: bool = True,
+    fps: float | None = None,
+) -> np.ndarray | Path:
+    """Render an animation of ``face`` driven by ``source``.
+
+    Parameters
+    ----------
+    source: a :class:`FapStream`, or an animation with ``.faps`` (and optional ``.audio``,
+        ``.audio_offset``).
+    face: the face to deform (``Face``-like: ``vertices``, ``triangles``, ``vertex_colors``,
+        ``parts``, ``deform``); None loads the default head.
+    out: None returns the frames; a path writes them by suffix: ``.mp4`` (H.264, with the
+        audio), ``.gif``, or a folder (no suffix) of ``frame_NNNNNN.png``; ``.png`` writes a
+        single-frame source as one still.
+    width, height: image size in pixels (even for ``.mp4``).
+    audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
+        ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
+    background: sRGB colour in [0, 1] behind the face; None uses the look's.
+    progress: show a progress bar when stderr is a terminal.
+    fps: resample the stream to this frame rate first (None keeps the stream's).
+
+    Returns
+    -------
+    ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the written
+    path. The camera is framed once on the neutral face and stays put.
+    """
+    stream, source_audio, source_offset = stream_of(source)
+    if fps is not None:
+        stream = stream.resample(fps)
+    audio = source_audio if audio is None else Path(audio)
+    offset = source_offset if audio_offset is None else float(audio_offset)
+    face = _default_face(face)
+    if out is not None and Path(out).suffix.lower() == ".png":
+        if stream.n_frames != 1:
+            raise ParameterError(
+                f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
+                "give a folder to write one PNG per frame"
+            )
+        return save_png(render_still(face, stream.values[0], width=width, height=height,
+                                     background=background), out)
+    if out is None and audio is not None and source_audio is None:
+        raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
+    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+        frames = iter_frames(renderer, face, stream, progress=progress)
+        if out is None:
+            result = np.empty((stream.n_frames, renderer.height, renderer.width, 3), np.uint8)
+            for i, image in enumerate(frames):
+                result[i] = image
+            return result
+        writer = open_writer(
+            out, fps=stream.fps, width=width, height=height,
+            audio=audio if Path(out).suffix.lower() == ".mp4" else None,
+            audio_offset=offset, duration=stream.duration,
+        )
+        try:
+            for image in frames:
+                writer.write(image)
+        except BaseException:
+            writer.abort()
+            raise
+        return writer.commit()
+
+
+def render_still(
+    face: Any,
+    pose: np.ndarray | None = None,
+    *,
+    width: int = 640,
+    height: int = 480,
+    background: Sequence[float] | None = None,
+) -> np.ndarray:
+    """One ``(height, width, 3) uint8`` image of ``face``.
+
+    ``pose`` is an ``(84,)`` FAP vector (deformed with ``face.deform_frame``), a ``(V, 3)``
+    vertex array, or None for the neutral face. For many stills of one face, keep a
+    :class:`~facelib.engine.render_scene.FaceRenderer` open instead (one OpenGL context).
+    """
+    face = _default_face(face)
+    if pose is None:
+        vertices = np.asarray(face.vertices, np.float32)
+    else:
+        pose = np.asarray(pose, np.float32)
+        if pose.shape == (N_FAPS,):
+            vertices = np.asarray(face.deform_frame(pose), np.float32)
+        elif pose.ndim == 2 and pose.shape[1] == 3:
+            vertices = pose
+        else:
+            raise ParameterError(
+                f"pose must be ({N_FAPS},) FAP values or (V, 3) vertices, got {pose.shape}"
+            )
+    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+        return renderer.frame(vertices)

@@ -1,0 +1,463 @@
+"""The face scene: per-part meshes, materials, three-point lights, auto-framed camera.
+
+:class:`FaceRenderer` owns one offscreen OpenGL context and renders ``(V, 3)`` vertex arrays
+of one face to ``(H, W, 3) uint8`` images. pyrender uploads a primitive's vertex buffer once
+(upstream issue #43), so changing ``Primitive.positions`` after the first render shows
+nothing; :class:`FaceRenderer` instead rewrites the interleaved vertex buffer of each part
+in place with ``glBufferSubData`` (positions and the per-frame smooth normals), which is the
+cheapest correct update measured in ``benchmarks/render_mesh_update.py``. Swapping in new
+mesh nodes (``mesh_update="swap"``) is also correct but re-creates every buffer per frame.
+
+Everything that is a matter of taste (materials per part, lights, camera field of view,
+background) lives in ``facelib/data/render_look.json``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from typing import Any, Literal
+
+import numpy as np
+import scipy.sparse as sp
+
+from facelib.engine.render_backend import INSTALL_HINT, import_pyrender
+from facelib.errors import FaceModelError, ParameterError, RenderError
+
+__all__ = ["FaceRenderer", "Look", "PartMesh", "frame_camera", "load_look", "split_parts",
+           "vertex_normals"]
+
+
+# -- look (data) -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Look:
+    """Materials, lights and camera settings (see ``facelib/data/render_look.json``)."""
+
+    parts: Mapping[str, Mapping[str, float]]
+    lights: tuple[Mapping[str, Any], ...]
+    ambient: tuple[float, float, float]
+    background: tuple[float, float, float]
+    yfov_deg: float
+    margin: float
+
+    def material(self, part: str) -> Mapping[str, float]:
+        return self.parts.get(part, self.parts["default"])
+
+
+@lru_cache(maxsize=1)
+def load_look() -> Look:
+    """The default :class:`Look` from ``facelib/data/render_look.json``."""
+    text = resources.files("facelib.data").joinpath("render_look.json").read_text("utf-8")
+    raw = json.loads(text)
+    return Look(
+        parts=raw["parts"],
+        lights=tuple(raw["lights"]),
+        ambient=tuple(raw["ambient"]),
+        background=tuple(raw["background"]),
+        yfov_deg=float(raw["camera"]["yfov_deg"]),
+        margin=float(raw["camera"]["margin"]),
+    )
+
+
+# -- geometry (pure numpy) ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PartMesh:
+    """One rendered piece of a face.
+
+    Attributes
+    ----------
+    name: the face part name (``skin``, ``eye_l``, ...; ``rest`` for triangles of no part).
+    vertex_ids: ``(Vp,) int64`` global vertex ids used by this piece, sorted.
+    triangles: ``(Fp, 3) uint32`` indices into ``vertex_ids``, wound counter-clockwise seen
+        from outside.
+    """
+
+    name: str
+    vertex_ids: np.ndarray
+    triangles: np.ndarray
+
+
+def _orient_outward(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """``triangles`` with winding flipped if most of their area faces the part's centre."""
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    cross = np.cross(b - a, c - a)
+    outward = (a + b + c) / 3.0 - vertices[np.unique(triangles)].mean(axis=0)
+    if np.einsum("ij,ij->", cross, outward) < 0:
+        return triangles[:, ::-1].copy()
+    return triangles
+
+
+def split_parts(
+    vertices: np.ndarray, triangles: np.ndarray, parts: Mapping[str, Any] | None
+) -> list[PartMesh]:
+    """Split a face into renderable pieces, one per part plus ``rest`` for unclaimed triangles.
+
+    ``vertices`` ``(V, 3)``, ``triangles`` ``(F, 3)`` global ids; ``parts`` maps names to
+    objects with ``triangles (Fp, 3)`` global ids (``Face.parts``). Windings are made to face
+    outward per piece so back-face culling never hides the front of a part.
+    """
+    vertices = np.asarray(vertices, np.float64)
+    triangles = np.asarray(triangles, np.int64)
+    n_vertices = len(vertices)
+    if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) == 0:
+        raise FaceModelError(f"face triangles must have shape (F, 3), F > 0; got {triangles.shape}")
+    if triangles.min() < 0 or triangles.max() >= n_vertices:
+        raise FaceModelError(
+            f"face triangles index vertex {int(triangles.max())} but there are {n_vertices}"
+        )
+
+    def keys(tris: np.ndarray) -> np.ndarray:
+        s = np.sort(tris, axis=1)
+        return (s[:, 0] * n_vertices + s[:, 1]) * n_vertices + s[:, 2]
+
+    pieces: list[tuple[str, np.ndarray]] = []
+    claimed = np.zeros(len(triangles), bool)
+    all_keys = keys(triangles)
+    for name, part in (parts or {}).items():
+        tris = np.asarray(part.triangles, np.int64).reshape(-1, 3)
+        if len(tris) == 0:
+            continue
+        if tris.min() < 0 or tris.max() >= n_vertices:
+            raise FaceModelError(
+                f"part {name!r} triangles index vertex {int(tris.max())} but there are "
+                f"{n_vertices}"
+            )
+        claimed |= np.isin(all_keys, keys(tris))
+        pieces.append((name, tris))
+    if not claimed.all():
+        pieces.append(("rest", triangles[~claimed]))
+    out = []
+    for name, tris in pieces:
+        ids = np.unique(tris)
+        local = np.searchsorted(ids, tris)
+        local = _orient_outward(vertices[ids], local)
+        out.append(PartMesh(name, ids, local.astype(np.uint32)))
+    return out
+
+
+def normal_operator(n_vertices: int, triangles: np.ndarray) -> sp.csr_matrix:
+    """``(V, F)`` sparse incidence matrix: vertex normal = sum of its triangles' normals."""
+    triangles = np.asarray(triangles, np.int64)
+    rows = triangles.ravel()
+    cols = np.repeat(np.arange(len(triangles)), 3)
+    data = np.ones(len(rows), np.float32)
+    return sp.csr_matrix((data, (rows, cols)), shape=(n_vertices, len(triangles)))
+
+
+def vertex_normals(
+    vertices: np.ndarray, triangles: np.ndarray, operator: sp.csr_matrix | None = None
+) -> np.ndarray:
+    """Smooth unit normals ``(V, 3) float32``: area-weighted mean of adjacent face normals.
+
+    ``vertices`` ``(V, 3)``, ``triangles`` ``(F, 3)`` indices; pass ``operator`` from
+    :func:`normal_operator` to reuse it across frames. Vertices of no triangle get ``+z``.
+    """
+    vertices = np.asarray(vertices, np.float32)
+    triangles = np.asarray(triangles, np.int64)
+    if operator is None:
+        operator = normal_operator(len(vertices), triangles)
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    summed = operator @ np.cross(b - a, c - a)
+    length = np.linalg.norm(summed, axis=1, keepdims=True)
+    normals = np.where(length > 0, summed / np.maximum(length, 1e-30), (0.0, 0.0, 1.0))
+    return normals.astype(np.float32)
+
+
+def frame_camera(
+    vertices: np.ndarray, *, aspect: float, yfov: float, margin: float
+) -> tuple[np.ndarray, float, float]:
+    """Camera pose looking along -z at the face's bounding box, filling the frame.
+
+    Returns ``(pose (4, 4) float64, znear, zfar)``; lengths in the face's units. The camera
+    sits on the +z side (the face looks along +z), centred on the box, far enough that the
+    box times ``margin`` fits both the vertical field of view ``yfov`` (radians) and the
+    horizontal one given by ``aspect`` = width / height.
+    """
+    lo, hi = np.min(vertices, axis=0), np.max(vertices, axis=0)
+    centre = (lo + hi) / 2.0
+    half = (hi - lo) / 2.0 * margin
+    tan_y = np.tan(yfov / 2.0)
+    depth = max(half[2], 1e-6)
+    distance = max(half[1] / tan_y, half[0] / (tan_y * aspect), 1e-6) + half[2]
+    pose = np.eye(4)
+    pose[:3, 3] = (centre[0], centre[1], centre[2] + distance)
+    znear = max(distance - 4.0 * depth, distance * 0.05)
+    zfar = distance + 4.0 * depth
+    return pose, float(znear), float(zfar)
+
+
+def _light_pose(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
+    """Pose whose -z axis points from the light (at the given direction) toward the origin."""
+    az, el = np.radians(azimuth_deg), np.radians(elevation_deg)
+    towards_light = np.array([np.sin(az) * np.cos(el), np.sin(el), np.cos(az) * np.cos(el)])
+    z = towards_light / np.linalg.norm(towards_light)
+    up = np.array([0.0, 1.0, 0.0]) if abs(z[1]) < 0.99 else np.array([0.0, 0.0, 1.0])
+    x = np.cross(up, z)
+    x /= np.linalg.norm(x)
+    pose = np.eye(4)
+    pose[:3, 0], pose[:3, 1], pose[:3, 2] = x, np.cross(z, x), z
+    return pose
+
+
+def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
+    rgb = np.clip(np.asarray(rgb, np.float32), 0.0, 1.0)
+    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+
+
+def _face_arrays(face: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    try:
+        vertices = np.asarray(face.vertices, np.float32)
+        triangles = np.asarray(face.triangles, np.int64)
+    except AttributeError as exc:
+        raise FaceModelError(f"{type(face).__name__} has no vertices/triangles: {exc}") from exc
+    if vertices.ndim != 2 or vertices.shape[1] != 3 or len(vertices) == 0:
+        raise FaceModelError(f"face vertices must have shape (V, 3), got {vertices.shape}")
+    colors = getattr(face, "vertex_colors", None)
+    colors = np.full_like(vertices, 0.8) if colors is None else np.asarray(colors, np.float32)
+    if colors.shape != vertices.shape:
+        raise FaceModelError(
+            f"face vertex_colors shape {colors.shape} differs from vertices {vertices.shape}"
+        )
+    return vertices, triangles, colors
+
+
+def _stabilise_program_cache(pr: Any, offscreen: Any) -> None:
+    """Make pyrender reuse its compiled shaders on OSMesa.
+
+    pyrender keys its shader cache by ``OpenGL.contextdata.getContext()``, which on OSMesa is
+    a fresh ctypes pointer object each call, so every frame missed the cache, recompiled
+    every shader and leaked the old programs (about 40% of the frame time at 640x480). A
+    renderer has exactly one context, so the cache here is keyed by shaders and defines only.
+    """
+    base = pr.shader_program.ShaderProgramCache
+    inner = getattr(offscreen, "_renderer", None)
+    if inner is None or not isinstance(getattr(inner, "_program_cache", None), base):
+        return
+
+    class _OneContextCache(base):
+        def __init__(self, shader_dir: str | None = None):
+            super().__init__(shader_dir=shader_dir)
+            self._by_source: dict[tuple, Any] = {}
+
+        def get_program(self, vertex_shader: str, fragment_shader: str,
+                        geometry_shader: str | None = None,
+                        defines: dict | None = None) -> Any:
+            key = (vertex_shader, fragment_shader, geometry_shader,
+                   tuple(sorted((defines or {}).items())))
+            program = self._by_source.get(key)
+            if program is None:
+                program = super().get_program(vertex_shader, fragment_shader,
+                                              geometry_shader, defines)
+                self._by_source[key] = program
+            return program
+
+        def clear(self) -> None:
+            super().clear()
+            self._by_source = {}
+
+    inner._program_cache = _OneContextCache(shader_dir=inner._program_cache.shader_dir)
+
+
+# -- the renderer ------------------------------------------------------------------------
+
+
+class FaceRenderer:
+    """Offscreen renderer of one face at one image size (holds an OpenGL context).
+
+    Use as a context manager or call :meth:`close`. :meth:`frame` takes ``(V, 3)`` vertices
+    (``Face.deform_frame`` output, same vertex order as ``face.vertices``) and returns
+    ``(height, width, 3) uint8`` RGB.
+
+    Parameters
+    ----------
+    face: object with ``vertices (V, 3)``, ``triangles (F, 3)``, ``vertex_colors (V, 3)`` sRGB
+        in [0, 1] and ``parts`` (name -> object with ``triangles``), e.g. ``facelib`` ``Face``.
+    width, height: image size in pixels.
+    background: sRGB colour behind the face; None takes the look's.
+    framing: ``(V, 3)`` vertices to frame the camera on (default: the neutral face).
+    mesh_update: ``"buffers"`` rewrites vertex buffers in place (fast), ``"swap"`` replaces the
+        mesh nodes each frame.
+    """
+
+    def __init__(
+        self,
+        face: Any,
+        *,
+        width: int = 640,
+        height: int = 480,
+        background: Sequence[float] | None = None,
+        framing: np.ndarray | None = None,
+        look: Look | None = None,
+        mesh_update: Literal["buffers", "swap"] = "buffers",
+        offscreen: bool = True,
+    ):
+        for label, value in (("width", width), ("height", height)):
+            if not isinstance(value, (int, np.integer)) or not 8 <= value <= 8192:
+                raise ParameterError(f"{label} must be an integer in [8, 8192], got {value!r}")
+        if mesh_update not in ("buffers", "swap"):
+            raise ParameterError(f"mesh_update must be 'buffers' or 'swap', got {mesh_update!r}")
+        self.width, self.height = int(width), int(height)
+        self.mesh_update = mesh_update
+        self.look = look or load_look()
+        self._pr = import_pyrender(offscreen=offscreen)
+        vertices, triangles, colors = _face_arrays(face)
+        self.n_vertices = len(vertices)
+        self._triangles = triangles
+        self._normal_op = normal_operator(self.n_vertices, triangles)
+        self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
+        linear = _srgb_to_linear(colors)
+        self._colors = [
+            np.hstack([linear[p.vertex_ids], np.ones((len(p.vertex_ids), 1), np.float32)])
+            for p in self._pieces
+        ]
+        self._materials = [self._material(p.name) for p in self._pieces]
+        self._interleaved = [np.empty((len(c), 10), np.float32) for c in self._colors]
+        for buf, color in zip(self._interleaved, self._colors, strict=True):
+            buf[:, 6:10] = color
+        self.scene = self._build_scene(vertices, background, framing)
+        self._renderer = None
+        self._primitives: list[Any] = []
+        self._nodes: list[Any] = []
+        self.set_vertices(vertices)
+        if offscreen:
+            try:
+                self._renderer = self._pr.OffscreenRenderer(self.width, self.height)
+            except Exception as exc:
+                raise RenderError(
+                    f"could not create a {self.width}x{self.height} offscreen OpenGL context "
+                    f"({type(exc).__name__}: {exc}); {INSTALL_HINT}"
+                ) from exc
+            _stabilise_program_cache(self._pr, self._renderer)
+
+    # -- scene construction -----------------------------------------------------------
+
+    def _material(self, part: str) -> Any:
+        spec = self.look.material(part)
+        return self._pr.MetallicRoughnessMaterial(
+            baseColorFactor=(1.0, 1.0, 1.0, 1.0),
+            metallicFactor=float(spec.get("metallic", 0.0)),
+            roughnessFactor=float(spec.get("roughness", 0.6)),
+        )
+
+    def _build_scene(
+        self, vertices: np.ndarray, background: Sequence[float] | None, framing: Any
+    ) -> Any:
+        pr = self._pr
+        bg = self.look.background if background is None else tuple(background)
+        if len(bg) not in (3, 4) or not all(0.0 <= float(c) <= 1.0 for c in bg):
+            raise ParameterError(f"background must be RGB in [0, 1], got {background!r}")
+        scene = pr.Scene(bg_color=(*bg[:3], 1.0), ambient_light=self.look.ambient)
+        yfov = np.radians(self.look.yfov_deg)
+        frame_on = vertices if framing is None else np.asarray(framing, np.float32)
+        pose, znear, zfar = frame_camera(
+            frame_on, aspect=self.width / self.height, yfov=yfov, margin=self.look.margin
+        )
+        camera = pr.PerspectiveCamera(
+            yfov=yfov, aspectRatio=self.width / self.height, znear=znear, zfar=zfar
+        )
+        scene.add(camera, pose=pose)
+        self.camera_pose = pose
+        for light in self.look.lights:
+            scene.add(
+                pr.DirectionalLight(color=light["color"], intensity=float(light["intensity"])),
+                pose=_light_pose(light["azimuth_deg"], light["elevation_deg"]),
+                name=light["name"],
+            )
+        return scene
+
+    def _new_meshes(self, vertices: np.ndarray, normals: np.ndarray) -> list[Any]:
+        pr = self._pr
+        meshes = []
+        for piece, color, material in zip(self._pieces, self._colors, self._materials,
+                                          strict=True):
+            primitive = pr.Primitive(
+                positions=vertices[piece.vertex_ids],
+                normals=normals[piece.vertex_ids],
+                color_0=color,
+                indices=piece.triangles,
+                material=material,
+            )
+            meshes.append(pr.Mesh([primitive], name=piece.name))
+        return meshes
+
+    # -- per-frame update ----------------------------------------------------------------
+
+    def set_vertices(self, vertices: np.ndarray) -> None:
+        """Move the face to ``vertices`` ``(V, 3)`` (recomputing smooth normals)."""
+        vertices = np.asarray(vertices, np.float32)
+        if vertices.shape != (self.n_vertices, 3):
+            raise ParameterError(
+                f"vertices must have shape ({self.n_vertices}, 3), got {vertices.shape}"
+            )
+        if not np.isfinite(vertices).all():
+            raise ParameterError("vertices must be finite")
+        normals = vertex_normals(vertices, self._triangles, self._normal_op)
+        uploaded = self._primitives and all(p._vaid is not None for p in self._primitives)
+        if self.mesh_update == "buffers" and uploaded and self._renderer is not None:
+            self._upload(vertices, normals)
+            return
+        for node in self._nodes:
+            self.scene.remove_node(node)
+        meshes = self._new_meshes(vertices, normals)
+        self._primitives = [m.primitives[0] for m in meshes]
+        self._nodes = [self.scene.add(m) for m in meshes]
+
+    def _upload(self, vertices: np.ndarray, normals: np.ndarray) -> None:
+        from OpenGL import GL
+
+        self._renderer._platform.make_current()
+        for piece, prim, buf in zip(self._pieces, self._primitives, self._interleaved,
+                                    strict=True):
+            buf[:, 0:3] = vertices[piece.vertex_ids]
+            buf[:, 3:6] = normals[piece.vertex_ids]
+            # keep the primitive's own arrays (bounds, shadows) true to what is drawn
+            prim._positions = buf[:, 0:3]
+            prim._normals = buf[:, 3:6]
+            prim._bounds = None
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, prim._buffers[0])
+            GL.glBufferSubData(GL.GL_ARRAY_BUFFER, 0, buf.nbytes, buf)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+
+    def frame(self, vertices: np.ndarray | None = None) -> np.ndarray:
+        """Render ``vertices`` ``(V, 3)`` (or the current pose) to ``(H, W, 3) uint8`` RGB."""
+        if self._renderer is None:
+            raise RenderError("this FaceRenderer is closed or was made for a window")
+        if vertices is not None:
+            self.set_vertices(vertices)
+        try:
+            color, _ = self._renderer.render(self.scene)
+        except Exception as exc:
+            raise RenderError(f"OpenGL rendering failed ({type(exc).__name__}: {exc})") from exc
+        return np.ascontiguousarray(color[:, :, :3], dtype=np.uint8)
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Pixel coordinates ``(N, 2) float64`` (column, row; origin top-left) of ``(N, 3)``
+        points in face coordinates, as this renderer's camera sees them."""
+        points = np.asarray(points, np.float64).reshape(-1, 3)
+        camera = self.scene.main_camera_node.camera
+        proj = camera.get_projection_matrix(self.width, self.height)
+        view = np.linalg.inv(self.camera_pose)
+        homo = np.hstack([points, np.ones((len(points), 1))]) @ (proj @ view).T
+        ndc = homo[:, :2] / homo[:, 3:4]
+        return np.stack(
+            [(ndc[:, 0] + 1) / 2 * self.width, (1 - ndc[:, 1]) / 2 * self.height], axis=1
+        )
+
+    def close(self) -> None:
+        """Release the OpenGL context (idempotent)."""
+        if self._renderer is not None:
+            self._renderer.delete()
+            self._renderer = None
+
+    def __enter__(self) -> FaceRenderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

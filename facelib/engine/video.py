@@ -1,0 +1,294 @@
+"""Writing rendered frames: PNG stills, PNG frame folders, MP4 (H.264 + audio) and GIF.
+
+Every writer is atomic: frames go to a temporary file or folder beside the target, which is
+renamed onto the target only when all frames were written; on any error the temporary is
+removed and the target is left as it was. MP4 and GIF go through the ffmpeg binary shipped
+by the ``imageio-ffmpeg`` wheel, fed raw RGB frames on a pipe (nothing held in memory).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import struct
+import subprocess
+import tempfile
+import zlib
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from facelib.errors import MissingExtraError, ParameterError, RenderError
+
+__all__ = [
+    "FrameWriter",
+    "encode_png",
+    "ffmpeg_exe",
+    "open_writer",
+    "probe_video",
+    "save_png",
+]
+
+_FRAME_NAME = "frame_{:06d}.png"
+
+
+# -- PNG ---------------------------------------------------------------------------------
+
+
+def _check_image(image: np.ndarray) -> np.ndarray:
+    image = np.asarray(image)
+    if image.ndim != 3 or image.shape[2] not in (3, 4) or image.dtype != np.uint8:
+        raise ParameterError(
+            f"an image must be (H, W, 3 or 4) uint8, got {image.shape} {image.dtype}"
+        )
+    return np.ascontiguousarray(image)
+
+
+def encode_png(image: np.ndarray, *, level: int = 6) -> bytes:
+    """PNG bytes of an ``(H, W, 3|4) uint8`` RGB(A) image (zlib ``level`` 0-9)."""
+    image = _check_image(image)
+    height, width, channels = image.shape
+    rows = np.zeros((height, 1 + width * channels), np.uint8)  # filter byte 0 per row
+    rows[:, 1:] = image.reshape(height, -1)
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 6 if channels == 4 else 2, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+            + chunk(b"IDAT", zlib.compress(rows.tobytes(), level)) + chunk(b"IEND", b""))
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _publish(tmp: Path, *, directory: bool = False) -> None:
+    """Give a temporary from ``mkstemp``/``mkdtemp`` (private 0600/0700) the permissions a
+    normally created file or folder would have under the current umask."""
+    tmp.chmod((0o777 if directory else 0o666) & ~_umask())
+
+
+def _atomic_bytes(path: Path, data: bytes) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+        _publish(Path(tmp))
+        Path(tmp).replace(path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def save_png(image: np.ndarray, path: str | os.PathLike[str]) -> Path:
+    """Write an ``(H, W, 3|4) uint8`` image to ``path`` as PNG, atomically; returns the path."""
+    path = Path(path)
+    _atomic_bytes(path, encode_png(image))
+    return path
+
+
+# -- ffmpeg ------------------------------------------------------------------------------
+
+
+def ffmpeg_exe() -> str:
+    """Path of the ffmpeg binary shipped by ``imageio-ffmpeg``."""
+    try:
+        import imageio_ffmpeg
+    except ImportError as exc:
+        raise MissingExtraError("video writing", "render", "imageio-ffmpeg") from exc
+    try:
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except RuntimeError as exc:
+        raise RenderError(f"imageio-ffmpeg has no ffmpeg binary for this platform: {exc}") from exc
+
+
+def probe_video(path: str | os.PathLike[str]) -> dict[str, object]:
+    """``{'frames': int, 'duration': float seconds, 'audio': bool}`` of a video file.
+
+    Frames are counted by decoding (exact); ``audio`` says whether an audio stream exists.
+    """
+    import imageio_ffmpeg
+
+    frames, duration = imageio_ffmpeg.count_frames_and_secs(str(path))
+    info = subprocess.run(
+        [ffmpeg_exe(), "-hide_banner", "-i", str(path)], capture_output=True, text=True,
+        check=False,
+    ).stderr
+    audio = any("Stream #" in line and "Audio:" in line for line in info.splitlines())
+    return {"frames": int(frames), "duration": float(duration), "audio": audio}
+
+
+# -- writers -----------------------------------------------------------------------------
+
+
+class FrameWriter(Protocol):
+    """Receives frames one by one; ``commit`` makes the output appear, ``abort`` drops it."""
+
+    path: Path
+
+    def write(self, frame: np.ndarray) -> None: ...
+    def commit(self) -> Path: ...
+    def abort(self) -> None: ...
+
+
+class _FfmpegWriter:
+    def __init__(self, path: Path, args: list[str], size: tuple[int, int], fps: float):
+        self.path = path
+        self._size = size
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+        os.close(fd)
+        self._tmp = Path(tmp)
+        width, height = size
+        command = [
+            ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y",
+            "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}",
+            "-framerate", f"{fps:.6g}", "-i", "pipe:0", *args, str(self._tmp),
+        ]
+        self._log = tempfile.TemporaryFile()  # noqa: SIM115 (closed in commit/abort)
+        self._proc = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                      stderr=self._log)
+        self.n_frames = 0
+
+    def _error(self, what: str) -> RenderError:
+        self._log.seek(0)
+        log = self._log.read().decode("utf-8", "replace").strip()
+        return RenderError(f"ffmpeg failed {what} {self.path}: {log or 'no message'}")
+
+    def write(self, frame: np.ndarray) -> None:
+        frame = _check_image(frame)[:, :, :3]
+        if frame.shape[:2] != (self._size[1], self._size[0]):
+            raise ParameterError(
+                f"frame {self.n_frames} is {frame.shape[1]}x{frame.shape[0]}, the video is "
+                f"{self._size[0]}x{self._size[1]}"
+            )
+        try:
+            self._proc.stdin.write(np.ascontiguousarray(frame).tobytes())
+        except BrokenPipeError:
+            self._proc.wait()
+            error = self._error("while writing")
+            self.abort()
+            raise error from None
+        self.n_frames += 1
+
+    def commit(self) -> Path:
+        self._proc.stdin.close()
+        if self._proc.wait() != 0:
+            error = self._error("while encoding")
+            self.abort()
+            raise error
+        self._log.close()
+        _publish(self._tmp)
+        self._tmp.replace(self.path)
+        return self.path
+
+    def abort(self) -> None:
+        if self._proc.poll() is None:
+            self._proc.kill()
+            self._proc.wait()
+        self._log.close()
+        self._tmp.unlink(missing_ok=True)
+
+
+class _PngFolderWriter:
+    def __init__(self, path: Path):
+        self.path = path
+        if path.exists() and not path.is_dir():
+            raise ParameterError(f"{path} exists and is not a folder; cannot write PNG frames")
+        if path.is_dir():
+            strangers = [p.name for p in path.iterdir() if not _is_frame_name(p.name)]
+            if strangers:
+                raise RenderError(
+                    f"{path} already holds files other than frames (e.g. {strangers[0]!r}); "
+                    "give an empty or new folder"
+                )
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))
+        self.n_frames = 0
+
+    def write(self, frame: np.ndarray) -> None:
+        (self._tmp / _FRAME_NAME.format(self.n_frames)).write_bytes(encode_png(frame, level=3))
+        self.n_frames += 1
+
+    def commit(self) -> Path:
+        _publish(self._tmp, directory=True)
+        old = None
+        if self.path.exists():
+            old = self.path.with_name(f".{self.path.name}.old-{os.getpid()}")
+            self.path.replace(old)
+        self._tmp.replace(self.path)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+        return self.path
+
+    def abort(self) -> None:
+        shutil.rmtree(self._tmp, ignore_errors=True)
+
+
+def _is_frame_name(name: str) -> bool:
+    return name.startswith("frame_") and name.endswith(".png") and name[6:-4].isdigit()
+
+
+def open_writer(
+    path: str | os.PathLike[str],
+    *,
+    fps: float,
+    width: int,
+    height: int,
+    audio: str | os.PathLike[str] | None = None,
+    audio_offset: float = 0.0,
+    duration: float | None = None,
+    crf: int = 18,
+) -> FrameWriter:
+    """A writer for ``path`` chosen by its suffix.
+
+    ``.mp4``: H.264 (yuv420p, ``crf`` quality 0-51, lower is better), with ``audio`` (any
+    file ffmpeg reads) muxed as AAC, starting ``audio_offset`` seconds into the video
+    (negative skips the audio's beginning) and cut at ``duration`` seconds; ``.gif``: an
+    optimised-palette animated GIF (no audio); no suffix or an existing folder: one
+    ``frame_NNNNNN.png`` per frame.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if not (isinstance(fps, (int, float)) and np.isfinite(fps) and fps > 0):
+        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    if audio is not None and suffix != ".mp4":
+        raise ParameterError(f"audio can only be muxed into .mp4, not {path.name!r}")
+    if suffix == ".mp4":
+        if width % 2 or height % 2:
+            raise ParameterError(
+                f"H.264 needs an even width and height, got {width}x{height}"
+            )
+        args: list[str] = []
+        if audio is not None:
+            audio = Path(audio)
+            if not audio.is_file():
+                raise ParameterError(f"audio file {str(audio)!r} does not exist")
+            if audio_offset < 0:
+                args += ["-ss", f"{-audio_offset:.6f}"]
+            args += ["-i", str(audio)]
+        args += ["-map", "0:v:0"]
+        if audio is not None:
+            args += ["-map", "1:a:0", "-c:a", "aac", "-b:a", "160k"]
+            if audio_offset > 0:
+                delay = round(audio_offset * 1000)
+                args += ["-af", f"adelay={delay}:all=1"]
+        args += ["-c:v", "libx264", "-preset", "medium", "-crf", str(int(crf)),
+                 "-pix_fmt", "yuv420p", "-movflags", "+faststart"]
+        if duration is not None:
+            args += ["-t", f"{duration:.6f}"]
+        return _FfmpegWriter(path, args, (width, height), fps)
+    if suffix == ".gif":
+        palette = "split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer"
+        return _FfmpegWriter(path, ["-vf", palette, "-loop", "0"], (width, height), fps)
+    if suffix == "" or path.is_dir():
+        return _PngFolderWriter(path)
+    raise ParameterError(
+        f"cannot tell what to write from {path.name!r}: use .mp4, .gif or a folder for PNG frames"
+    )
