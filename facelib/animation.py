@@ -102,7 +102,7 @@ def _with_importance(speech: Any, rules: SyncRules) -> FapTrack:
     for span in speech.timeline:
         first = math.floor(span.start_ms * track.fps / 1000)
         last = math.ceil(span.end_ms * track.fps / 1000)
-        factor[first:last] = rules.viseme_importance.get(span.viseme, 1.0)
+        factor[first:last] = rules.viseme_importance.get(span.name, 1.0)
     return FapTrack(track.fps, track.values, track.weight * factor[:, None])
 
 

@@ -1,0 +1,263 @@
+"""Forced alignment of speech audio to its transcript, and phone-loop recognition, with
+pocketsphinx (the ``speech`` extra): audio -> phone and word timelines -> visemes.
+
+Two passes: the words are aligned first (``set_align_text``), then the phones inside them
+(``set_alignment``). Words missing from the dictionary get a letter-to-sound pronunciation.
+A transcript that does not match the audio either fails to align (:class:`SpeechError`) or
+aligns implausibly; the plausibility checks then warn or raise naming the word.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from collections.abc import Sequence
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from facelib.errors import ParameterError, SpeechError
+from facelib.visemes.audio import ALIGN_RATE, load_speech, to_pcm16
+from facelib.visemes.mapping import visemes_for
+from facelib.visemes.pronounce import model_dir, pronounce, tokenize
+from facelib.visemes.tables import phone_durations
+from facelib.visemes.timeline import SILENCE, Span, SpeechTimeline
+
+__all__ = ["SpeechWarning", "align", "alignment_settings"]
+
+OnImplausible = Literal["warn", "raise", "ignore"]
+_NOISE = {"SIL", "NSN", "SPN", "<sil>", "<s>", "</s>", "[NOISE]", "+NSN+", "+SPN+"}
+_PHONE_LOOP = "_facelib_phone_loop"
+
+
+class SpeechWarning(UserWarning):
+    """An alignment succeeded but looks implausible (named word, reason)."""
+
+
+@cache
+def alignment_settings() -> dict[str, Any]:
+    """The settings of ``facelib/data/visemes/alignment.json`` (keys without ``_about``)."""
+    text = resources.files("facelib").joinpath("data/visemes/alignment.json").read_text("utf-8")
+    return {k: v for k, v in json.loads(text).items() if not k.startswith("_")}
+
+
+@cache
+def _decoder() -> Any:
+    """One pocketsphinx decoder per process (loading the model takes about a second)."""
+    try:
+        from pocketsphinx import Decoder
+    except ImportError as exc:
+        from facelib.errors import MissingExtraError
+
+        raise MissingExtraError("speech alignment", "speech", "pocketsphinx") from exc
+    decoder = Decoder(bestpath=False, loglevel="FATAL")
+    decoder.add_allphone_file(_PHONE_LOOP, str(model_dir() / "en-us-phone.lm.bin"))
+    return decoder
+
+
+def align(
+    audio: str | Path | np.ndarray,
+    text: str | None = None,
+    *,
+    sample_rate: int | None = None,
+    on_implausible: OnImplausible = "warn",
+) -> SpeechTimeline:
+    """Phones, words and visemes of speech ``audio``.
+
+    Parameters
+    ----------
+    audio:
+        A sound file in any format soundfile reads, or an array (then give ``sample_rate``).
+    text:
+        The transcript. With it: forced alignment (``source="forced"``). Without: phone-loop
+        recognition (``source="phone-loop"``, no words; less accurate).
+    on_implausible:
+        What to do when the alignment looks wrong (a phone three times its usual length, a
+        word squeezed to the minimum duration, a very poor acoustic score, a pause that
+        sounds like speech; thresholds in ``alignment.json``): ``"warn"`` (a
+        :class:`SpeechWarning` naming the word), ``"raise"`` (:class:`SpeechError`) or
+        ``"ignore"``.
+
+    Returns
+    -------
+    SpeechTimeline with times in ms from the start of the audio.
+
+    Raises
+    ------
+    SpeechError: unreadable, empty or silent audio; a transcript without words or that
+        cannot be aligned to the audio. MissingExtraError: pocketsphinx is not installed.
+    """
+    if on_implausible not in ("warn", "raise", "ignore"):
+        raise ParameterError(
+            f"on_implausible must be warn, raise or ignore, not {on_implausible!r}"
+        )
+    samples = load_speech(audio, sample_rate=sample_rate)
+    duration_ms = round(samples.size * 1000 / ALIGN_RATE)
+    settings = alignment_settings()
+    pcm = to_pcm16(samples, pad_ms=settings["pad_ms"])
+    where = audio if not isinstance(audio, np.ndarray) else None
+    if text is None:
+        phones = _phone_loop(pcm, duration_ms)
+        return SpeechTimeline(phones, (), visemes_for(phones), "phone-loop", duration_ms)
+    phones, words, problems = _forced(pcm, text, duration_ms, where)
+    if problems and on_implausible != "ignore":
+        message = "implausible alignment: " + "; ".join(problems)
+        if on_implausible == "raise":
+            raise SpeechError(message, path=where)
+        warnings.warn(message, SpeechWarning, stacklevel=2)
+    return SpeechTimeline(phones, words, visemes_for(phones), "forced", duration_ms)
+
+
+def _decode(decoder: Any, pcm: bytes) -> None:
+    decoder.start_utt()
+    decoder.process_raw(pcm, full_utt=True)
+    decoder.end_utt()
+
+
+def _forced(
+    pcm: bytes, text: str, duration_ms: int, where: str | Path | None
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
+    words = [t for t in tokenize(text) if t[0].isalpha()]
+    decoder = _decoder()
+    guessed = []
+    for word in words:
+        if decoder.lookup_word(word) is None:
+            phones, _ = pronounce(word)
+            decoder.add_word(word, " ".join(phones), update=True)
+            guessed.append(word)
+    decoder.set_align_text(" ".join(words))
+    _decode(decoder, pcm)
+    try:
+        decoder.set_alignment()
+    except RuntimeError as exc:
+        raise SpeechError(
+            f"the transcript {text!r} cannot be aligned to the audio (does it match what is said?)",
+            path=where,
+        ) from exc
+    _decode(decoder, pcm)
+    alignment = decoder.get_alignment()
+    if alignment is None:
+        raise SpeechError(f"the transcript {text!r} cannot be aligned to the audio", path=where)
+    settings = alignment_settings()
+    to_ms = _frame_to_ms(duration_ms)
+    phone_spans: list[Span] = []
+    word_spans: list[Span] = []
+    problems: list[str] = []
+    # copy out of pocketsphinx at once: its entries are views into the decoder's memory
+    entries = [(w.name.split("(")[0], w.start, [(p.name, p.start, p.duration, p.score)
+                                                  for p in w]) for w in alignment]
+    n_entries = len(entries)
+    for k, (name, word_start, word_phones) in enumerate(entries):
+        is_sil = name in _NOISE
+        start = to_ms(word_start)
+        end = to_ms(word_phones[-1][1] + word_phones[-1][2]) if word_phones else start
+        _append(word_spans, SILENCE if is_sil else name, start, end)
+        for label, p_start, p_dur, _ in word_phones:
+            shown = SILENCE if (is_sil or label in _NOISE) else label
+            _append(phone_spans, shown, to_ms(p_start), to_ms(p_start + p_dur))
+        if not is_sil:
+            final = k + 1 == n_entries or entries[k + 1][0] in _NOISE
+            problems += _check_word(name, word_phones, settings, name in guessed, final=final)
+        else:
+            problems += _check_pause(word_spans, word_phones, settings)
+    return _cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems
+
+
+def _check_word(
+    word: str,
+    phones: Sequence[tuple[str, int, int, int]],
+    settings: dict[str, Any],
+    oov: bool,
+    *,
+    final: bool,
+) -> list[str]:
+    frame_ms = settings["frame_ms"]
+    note = " (pronunciation guessed)" if oov else ""
+    means = phone_durations()
+    out = []
+    for i, (label, _, dur, _) in enumerate(phones):
+        factor = settings["final_phone_factor" if final and i == len(phones) - 1
+                          else "max_phone_factor"]
+        limit = factor * means.get(label, (200, 0))[0]
+        if dur * frame_ms > limit:
+            out.append(f"word {word!r}{note}: phone {label} lasts {dur * frame_ms} ms "
+                       f"(more than {limit:.0f} ms)")
+    min_frames = settings["min_phone_ms"] // frame_ms
+    if len(phones) >= 3 and all(dur <= min_frames for _, _, dur, _ in phones):
+        out.append(f"word {word!r}{note}: every phone squeezed to {settings['min_phone_ms']} ms")
+    frames = sum(dur for _, _, dur, _ in phones)
+    score = sum(s for *_, s in phones) / max(frames, 1)
+    if score < settings["min_word_score_per_frame"]:
+        out.append(f"word {word!r}{note}: poor acoustic match ({score:.0f} per frame)")
+    return out
+
+
+def _check_pause(
+    words: Sequence[Span], phones: Sequence[tuple[str, int, int, int]], settings: dict[str, Any]
+) -> list[str]:
+    """A long pause that scores like speech holds words missing from the transcript."""
+    frames = sum(dur for _, _, dur, _ in phones)
+    score = sum(s for *_, s in phones) / max(frames, 1)
+    if frames * settings["frame_ms"] < settings["check_pause_ms"]:
+        return []
+    if score >= settings["min_pause_score_per_frame"]:
+        return []
+    spoken = [w.label for w in words if w.label != SILENCE]
+    after = f"after word {spoken[-1]!r}" if spoken else "before the first word"
+    message = (f"the pause {after} sounds like speech ({score:.0f} per frame); "
+               "is a word missing from the transcript?")
+    return [message]
+
+
+def _phone_loop(pcm: bytes, duration_ms: int) -> tuple[Span, ...]:
+    decoder = _decoder()
+    decoder.activate_search(_PHONE_LOOP)
+    _decode(decoder, pcm)
+    to_ms = _frame_to_ms(duration_ms)
+    spans: list[Span] = []
+    for seg in decoder.seg():
+        label = SILENCE if seg.word in _NOISE else seg.word
+        _append(spans, label, to_ms(seg.start_frame), to_ms(seg.end_frame + 1))
+    if not spans or all(s.label == SILENCE for s in spans):
+        raise SpeechError("no speech recognised in the audio")
+    return _cover(spans, duration_ms)
+
+
+def _frame_to_ms(duration_ms: int) -> Any:
+    settings = alignment_settings()
+    pad, frame = settings["pad_ms"], settings["frame_ms"]
+
+    def to_ms(frame_index: int) -> int:
+        return int(min(max(frame_index * frame - pad, 0), duration_ms))
+
+    return to_ms
+
+
+def _append(spans: list[Span], label: str, start: int, end: int) -> None:
+    """Append a span, dropping empty ones and joining consecutive silences."""
+    if spans:
+        start = max(start, spans[-1].end_ms)
+    if end <= start:
+        return
+    if spans and label == SILENCE and spans[-1].label == SILENCE:
+        spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
+    elif spans and spans[-1].end_ms < start:
+        _append(spans, SILENCE, spans[-1].end_ms, start)
+        _append(spans, label, start, end)
+    else:
+        spans.append(Span(label, start, end))
+
+
+def _cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
+    """The spans with silence filling the time before the first and after the last."""
+    out: list[Span] = []
+    if spans and spans[0].start_ms > 0:
+        out.append(Span(SILENCE, 0, spans[0].start_ms))
+    for span in spans:
+        _append(out, span.label, span.start_ms, span.end_ms)
+    if out and out[-1].end_ms < duration_ms:
+        _append(out, SILENCE, out[-1].end_ms, duration_ms)
+    return tuple(out)
