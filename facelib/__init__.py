@@ -1,12 +1,25 @@
 """facelib: scriptable MPEG-4 facial animation.
 
 Storyboards in FDL (Lua) become FAP streams, deformed face meshes, videos and ``.fap``
-files. ``import facelib`` loads numpy, scipy and lupa at most; rendering, speech alignment
-and plotting load on first use.
+files::
+
+    import facelib
+    animation = facelib.run_fdl("examples/hello/hello.fdl")
+    facelib.write_fap(animation.faps, "hello.fap")
+    facelib.render(animation, out="hello.mp4")
+
+``import facelib`` loads numpy, scipy and lupa at most; rendering (OpenGL), speech
+alignment (pocketsphinx) and plotting (matplotlib) load on first use.
 """
 
+from typing import Any
+
+from facelib import expressions, fdl, gaze, mpeg4, sync, visemes
+from facelib.animation import Animation, animate, run_fdl
+from facelib.engine import Face, load_face
 from facelib.errors import (
     FacelibError,
+    FacelibWarning,
     FaceModelError,
     FapFormatError,
     FdlError,
@@ -19,9 +32,30 @@ from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, wri
 
 __version__ = "0.1.0"
 
+_LAZY = {
+    "render": "facelib.engine.render",
+    "render_still": "facelib.engine.render",
+    "save_png": "facelib.engine.render",
+    "view": "facelib.engine.viewer",
+    "plot_curves": "facelib.plot",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Rendering, the viewer and plotting import OpenGL or matplotlib: load them on use."""
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'facelib' has no attribute {name!r}")
+
+
 __all__ = [
+    "Animation",
+    "Face",
     "FaceModelError",
     "FacelibError",
+    "FacelibWarning",
     "FapFormatError",
     "FapStream",
     "FapTrack",
@@ -31,8 +65,22 @@ __all__ = [
     "RenderError",
     "SpeechError",
     "__version__",
+    "animate",
+    "expressions",
     "fap",
+    "fdl",
     "feature_point",
+    "gaze",
+    "load_face",
+    "mpeg4",
+    "plot_curves",
     "read_fap",
+    "render",
+    "render_still",
+    "run_fdl",
+    "save_png",
+    "sync",
+    "view",
+    "visemes",
     "write_fap",
 ]

@@ -54,14 +54,16 @@ def animate(
 
     seed: overrides ``storyboard.seed``; the same storyboard and seed give the same stream
     bit for bit. rules: the synchronizer's weights (default ``facelib/data/sync.json``).
-    The stream lasts as long as the longest track (the speech, or the last cue).
+    The stream lasts as long as the longest track: the speech, or the last cue including a
+    frame at its very end.
     """
     if seed is not None:
         storyboard = replace(storyboard, seed=int(seed))
     rules = rules or SyncRules.load()
     fps = storyboard.fps
     speech = visemes.animate(storyboard.speech, fps=fps) if storyboard.speech else None
-    n_frames = math.ceil(storyboard.cues_end_ms * fps / 1000 - 1e-9)
+    # one frame past the last cue's end, so the face is shown settling back to neutral
+    n_frames = math.floor(storyboard.cues_end_ms * fps / 1000 + 1e-9) + 1
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
     speaking = np.zeros(n_frames, bool)

@@ -4,20 +4,21 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 import warnings
 from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
 
 import facelib
 from facelib.errors import FacelibError
-from facelib.mpeg4 import fap, read_fap_file
+from facelib.mpeg4 import fap, read_fap, read_fap_file, write_fap
 
 __all__ = ["main"]
 
 
 def _info(args: argparse.Namespace) -> int:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        file = read_fap_file(args.file, strict=args.strict)
+    file = read_fap_file(args.file, strict=args.strict)
     stream = file.stream
     print(f"file:      {args.file}")
     print(f"name:      {file.name}   (version {file.version}, dialect {file.dialect})")
@@ -39,9 +40,92 @@ def _info(args: argparse.Namespace) -> int:
     for slot, label in ((0, "viseme"), (1, "expression")):
         if stream.mask[:, slot].any():
             print(f"  FAP {slot + 1} ({label}) set in {int(stream.mask[:, slot].sum())} frames")
-    for w in caught:
-        print(f"warning:   {w.message}", file=sys.stderr)
     return 0
+
+
+def _check(args: argparse.Namespace) -> int:
+    from facelib.fdl import describe, load
+
+    print(describe(load(args.story, seed=args.seed)))
+    return 0
+
+
+def _animation(path: str, seed: int | None) -> Any:
+    """A storyboard's Animation, or a .fap file's stream."""
+    if Path(path).suffix.lower() == ".fap":
+        return read_fap(path)
+    from facelib.animation import run_fdl
+
+    return run_fdl(path, seed=seed)
+
+
+def _write_fap(animation: Any, out: str | Path | None, dialect: str) -> Path | None:
+    target = out if out is not None else animation.storyboard.output
+    if target is None:
+        return None
+    written = write_fap(animation.faps, target, dialect=dialect)
+    print(f"wrote {written} ({animation.faps.n_frames} frames, {animation.faps.duration:.2f} s)")
+    return written
+
+
+def _run(args: argparse.Namespace) -> int:
+    from facelib.animation import run_fdl
+
+    animation = run_fdl(args.story, seed=args.seed)
+    if _write_fap(animation, args.output, args.dialect) is None:
+        raise FacelibError(f"{args.story} names no output: give one with -o OUT.fap")
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    from facelib.engine import load_face
+    from facelib.engine.render import render
+
+    started = time.perf_counter()
+    source = _animation(args.source, args.seed)
+    if args.fap is not None:
+        _write_fap(source, args.fap, "standard")
+    audio = getattr(args, "audio", None)
+    out = render(source, face=load_face(args.face), out=args.output, width=args.width,
+                 height=args.height, audio=audio, fps=args.fps)
+    print(f"wrote {out} in {time.perf_counter() - started:.1f} s")
+    return 0
+
+
+def _view(args: argparse.Namespace) -> int:
+    from facelib.engine import load_face
+    from facelib.engine.viewer import view
+
+    view(_animation(args.source, args.seed), face=load_face(args.face), loop=args.loop)
+    return 0
+
+
+def _plot(args: argparse.Namespace) -> int:
+    from facelib.plot import plot_curves
+
+    out = plot_curves(_animation(args.source, args.seed), args.output, title=args.source)
+    print(f"wrote {out}")
+    return 0
+
+
+def _align(args: argparse.Namespace) -> int:
+    from facelib.visemes import align, write_timeline
+
+    text = args.text
+    if args.text_file is not None:
+        text = Path(args.text_file).read_text(encoding="utf-8")
+    out = write_timeline(align(args.audio, text), args.output, fps=args.fps)
+    print(f"wrote {out}")
+    return 0
+
+
+def _add_render_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("-o", "--output", required=True,
+                         help="OUT.mp4, OUT.gif, or a folder for PNG frames")
+    command.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    command.add_argument("--width", type=int, default=640)
+    command.add_argument("--height", type=int, default=480)
+    command.add_argument("--fps", type=float, help="resample to this frame rate")
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -55,6 +139,53 @@ def _build_parser() -> argparse.ArgumentParser:
     info.add_argument("file", help="the .fap file")
     info.add_argument("--strict", action="store_true", help="accept only the standard profile")
     info.set_defaults(run=_info)
+
+    check = commands.add_parser("check", help="check a storyboard and list its cues")
+    check.add_argument("story", help="the .fdl storyboard")
+    check.add_argument("--seed", type=int)
+    check.set_defaults(run=_check)
+
+    run = commands.add_parser("run", help="animate a storyboard into a .fap file")
+    run.add_argument("story", help="the .fdl storyboard")
+    run.add_argument("-o", "--output", help="the .fap file (default: the storyboard's output)")
+    run.add_argument("--seed", type=int, help="seed of the random processes")
+    run.add_argument("--dialect", default="standard",
+                     choices=("standard", "xface", "greta", "extended"))
+    run.set_defaults(run=_run)
+
+    render = commands.add_parser("render", help="render a storyboard (or .fap) to video")
+    render.add_argument("source", help="STORY.fdl or FILE.fap")
+    _add_render_options(render)
+    render.add_argument("--fap", help="also write the animation's .fap here")
+    render.add_argument("--seed", type=int)
+    render.set_defaults(run=_render)
+
+    play = commands.add_parser("play", help="render a .fap file, with optional audio")
+    play.add_argument("source", metavar="FILE.fap")
+    _add_render_options(play)
+    play.add_argument("--audio", help="speech audio to mux into the video")
+    play.set_defaults(run=_render, fap=None, seed=None)
+
+    view = commands.add_parser("view", help="play a .fap or storyboard in a window")
+    view.add_argument("source", help="STORY.fdl or FILE.fap")
+    view.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    view.add_argument("--loop", action="store_true")
+    view.add_argument("--seed", type=int)
+    view.set_defaults(run=_view)
+
+    plot = commands.add_parser("plot", help="plot FAP curves of a storyboard or .fap")
+    plot.add_argument("source", help="STORY.fdl or FILE.fap")
+    plot.add_argument("-o", "--output", required=True, help="curves.png (or .svg, .pdf)")
+    plot.add_argument("--seed", type=int)
+    plot.set_defaults(run=_plot)
+
+    align = commands.add_parser("align", help="align speech audio to visemes")
+    align.add_argument("audio", help="speech audio (any format soundfile reads)")
+    align.add_argument("--text", help="the transcript (omit for phone-loop recognition)")
+    align.add_argument("--text-file", help="a file holding the transcript")
+    align.add_argument("-o", "--output", required=True, help="OUT.json, OUT.tsv or OUT.sb")
+    align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
+    align.set_defaults(run=_align)
     return parser
 
 
@@ -66,11 +197,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     if run is None:
         parser.print_help()
         return 2
-    try:
-        return run(args)
-    except FacelibError as exc:
-        print(f"facelib: error: {exc}", file=sys.stderr)
-        return 1
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", facelib.FacelibWarning)
+        try:
+            status = run(args)
+        except FacelibError as exc:
+            print(f"facelib: error: {exc}", file=sys.stderr)
+            status = 1
+    for warning in caught:
+        print(f"facelib: warning: {warning.message}", file=sys.stderr)
+    return status
 
 
 if __name__ == "__main__":

@@ -129,6 +129,17 @@ def test_writer_refuses_bad_requests(tmp_path):
     assert not list(tmp_path.iterdir())
 
 
+def test_written_files_get_the_usual_permissions(tmp_path):
+    import os
+
+    umask = os.umask(0o022)
+    try:
+        out = write_fap(FapStream(25, np.zeros((1, 84))), tmp_path / "p.fap")
+    finally:
+        os.umask(umask)
+    assert out.stat().st_mode & 0o777 == 0o644
+
+
 def test_failed_write_leaves_the_old_file(tmp_path, monkeypatch):
     path = tmp_path / "keep.fap"
     path.write_text("old")

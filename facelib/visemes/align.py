@@ -19,7 +19,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from facelib.errors import ParameterError, SpeechError
+from facelib.errors import FacelibWarning, ParameterError, SpeechError
 from facelib.visemes.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.visemes.mapping import visemes_for
 from facelib.visemes.pronounce import model_dir, pronounce, tokenize
@@ -33,7 +33,7 @@ _NOISE = {"SIL", "NSN", "SPN", "<sil>", "<s>", "</s>", "[NOISE]", "+NSN+", "+SPN
 _PHONE_LOOP = "_facelib_phone_loop"
 
 
-class SpeechWarning(UserWarning):
+class SpeechWarning(FacelibWarning):
     """An alignment succeeded but looks implausible (named word, reason)."""
 
 
@@ -45,15 +45,17 @@ def alignment_settings() -> dict[str, Any]:
 
 
 @cache
-def _decoder() -> Any:
-    """One pocketsphinx decoder per process (loading the model takes about a second)."""
+def _decoder(*, wide: bool = False) -> Any:
+    """One pocketsphinx decoder per process and beam setting (loading the model takes
+    about a second); ``wide`` gives the fallback with the wide beams of alignment.json."""
     try:
         from pocketsphinx import Decoder
     except ImportError as exc:
         from facelib.errors import MissingExtraError
 
         raise MissingExtraError("speech alignment", "speech", "pocketsphinx") from exc
-    decoder = Decoder(bestpath=False, loglevel="FATAL")
+    beams = alignment_settings()["wide_beams"] if wide else {}
+    decoder = Decoder(bestpath=False, loglevel="FATAL", **beams)
     decoder.add_allphone_file(_PHONE_LOOP, str(model_dir() / "en-us-phone.lm.bin"))
     return decoder
 
@@ -121,7 +123,20 @@ def _forced(
     pcm: bytes, text: str, duration_ms: int, where: str | Path | None
 ) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
     words = [t for t in tokenize(text) if t[0].isalpha()]
-    decoder = _decoder()
+    try:
+        return _forced_with(_decoder(), pcm, words, text=text, duration_ms=duration_ms,
+                            where=where)
+    except SpeechError:
+        # The default beams sometimes prune every path of a correct transcript (seen on
+        # espeak-ng speech); the wide beams find it, at some cost in boundary precision.
+        return _forced_with(_decoder(wide=True), pcm, words, text=text,
+                            duration_ms=duration_ms, where=where)
+
+
+def _forced_with(
+    decoder: Any, pcm: bytes, words: list[str], *, text: str, duration_ms: int,
+    where: str | Path | None,
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
     guessed = []
     for word in words:
         if decoder.lookup_word(word) is None:

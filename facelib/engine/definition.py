@@ -1,0 +1,232 @@
+"""Reading and validating a face definition (FDP): a versioned JSON file beside its mesh.
+
+The format is documented in ``docs/face-definition.md``. The mesh is an ``.npz`` file with
+``vertices (V, 3) float``, ``triangles (F, 3) int`` and ``vertex_colors (V, 3)`` (uint8 0-255
+or float 0-1).
+"""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facelib.engine.face import DEFORMERS, PART_NAMES, Face, Region
+from facelib.errors import FaceModelError
+from facelib.mpeg4.tables import fap_table, feature_point_table
+
+__all__ = ["FORMAT", "VERSION", "load_face", "required_feature_points"]
+
+FORMAT = "facelib-face"
+VERSION = 1
+PIVOTS = ("eye_l", "eye_r", "head", "jaw")
+
+
+def required_feature_points() -> tuple[str, ...]:
+    """Feature points every face must place: those moved by FAP 3-84.
+
+    7.1 (top of the spine) is exempt: head rotations use the ``head`` pivot instead.
+    """
+    needed = {p for f in fap_table()[2:] for p in f.feature_points} - {"7.1"}
+    order = list(feature_point_table())
+    return tuple(sorted(needed, key=order.index))
+
+
+def _default_path() -> Path:
+    return Path(str(resources.files("facelib.data").joinpath("head", "default_head.json")))
+
+
+def load_face(path: str | Path | None = None) -> Face:
+    """Load a face definition and its mesh, validate them and compile the deformers.
+
+    Parameters
+    ----------
+    path: the JSON face definition; None loads facelib's default head (metres).
+
+    Raises
+    ------
+    FaceModelError: unreadable or malformed file, missing feature points, out-of-range
+        indices, empty regions, unknown deformers or pivots; the message names the item.
+    """
+    path = _default_path() if path is None else Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise FaceModelError(f"cannot read face definition: {exc.strerror}", path=path) from exc
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FaceModelError(f"invalid JSON: {exc.msg}", path=path, line=exc.lineno) from exc
+    return _Reader(path, doc).face()
+
+
+class _Reader:
+    def __init__(self, path: Path, doc: Any):
+        self.path = path
+        self.doc = doc
+
+    def fail(self, message: str) -> FaceModelError:
+        return FaceModelError(message, path=self.path)
+
+    def get(self, key: str, kind: type | tuple[type, ...]) -> Any:
+        if not isinstance(self.doc, dict) or key not in self.doc:
+            raise self.fail(f"the face definition has no {key!r} entry")
+        value = self.doc[key]
+        if not isinstance(value, kind):
+            raise self.fail(f"{key!r} must be a {getattr(kind, '__name__', kind)}, not {value!r}")
+        return value
+
+    def face(self) -> Face:
+        if self.get("format", str) != FORMAT:
+            raise self.fail(f"format is {self.doc['format']!r}, expected {FORMAT!r}")
+        version = self.get("version", int)
+        if version != VERSION:
+            raise self.fail(f"face definition version {version} is not supported (only {VERSION})")
+        vertices, triangles, colours = self.mesh()
+        nv = len(vertices)
+        parts = self.parts(nv)
+        fps = self.feature_points(nv)
+        pivots = self.pivots()
+        regions = self.regions(nv, fps, pivots)
+        neck = self.neck()
+        try:
+            return Face.build(vertices=vertices, triangles=triangles, vertex_colors=colours,
+                              parts=parts, feature_points=fps, regions=regions, pivots=pivots,
+                              neck=neck)
+        except FaceModelError as exc:
+            raise self.fail(exc.message) from exc
+
+    def mesh(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        mesh_path = self.path.parent / self.get("mesh", str)
+        try:
+            with np.load(mesh_path, allow_pickle=False) as data:
+                arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
+        except (OSError, ValueError) as exc:
+            raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
+        except KeyError as exc:
+            raise self.fail(f"mesh {mesh_path.name!r} lacks the array {exc.args[0]!r}") from exc
+        v, t, c = arrays["vertices"], arrays["triangles"], arrays["vertex_colors"]
+        if v.ndim != 2 or v.shape[1] != 3 or not len(v) or not np.all(np.isfinite(v)):
+            raise self.fail(f"mesh vertices must be finite (V, 3), got shape {v.shape}")
+        if t.ndim != 2 or t.shape[1] != 3 or not np.issubdtype(t.dtype, np.integer):
+            raise self.fail(f"mesh triangles must be integer (F, 3), got {t.dtype} {t.shape}")
+        if t.size and (t.min() < 0 or t.max() >= len(v)):
+            raise self.fail(f"mesh triangle index {int(t.max())} is outside 0-{len(v) - 1}")
+        if c.shape != v.shape:
+            raise self.fail(f"vertex_colors must have shape {v.shape}, got {c.shape}")
+        c = c / 255.0 if np.issubdtype(c.dtype, np.integer) else c.astype(np.float64)
+        return v, t, np.clip(c, 0.0, 1.0)
+
+    def index(self, value: Any, nv: int, what: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < nv:
+            raise self.fail(f"{what} is {value!r}, not a vertex index in 0-{nv - 1}")
+        return value
+
+    def indices(self, values: Any, nv: int, what: str, *, allow_empty: bool = False) -> np.ndarray:
+        if not isinstance(values, list) or (not values and not allow_empty):
+            raise self.fail(f"{what} must be a non-empty list of vertex indices")
+        arr = np.asarray(values)
+        if arr.size and (arr.dtype.kind not in "iu" or arr.min() < 0 or arr.max() >= nv):
+            bad = next(v for v in values if not (isinstance(v, int) and 0 <= v < nv))
+            raise self.fail(f"{what} contains {bad!r}, not a vertex index in 0-{nv - 1}")
+        return arr.astype(np.int32)
+
+    def parts(self, nv: int) -> dict[str, np.ndarray]:
+        raw = self.get("parts", dict)
+        out = {}
+        for name in PART_NAMES:
+            if name not in raw:
+                raise self.fail(f"parts has no {name!r}")
+            span = raw[name]
+            if (not isinstance(span, list) or len(span) != 2
+                    or not all(isinstance(s, int) for s in span)
+                    or not 0 <= span[0] < span[1] <= nv):
+                raise self.fail(f"parts[{name!r}] = {span!r} is not a vertex range [start, stop)"
+                                f" within 0-{nv}")
+            out[name] = np.arange(span[0], span[1], dtype=np.int32)
+        unknown = set(raw) - set(PART_NAMES)
+        if unknown:
+            raise self.fail(f"unknown part {sorted(unknown)[0]!r}; parts are {PART_NAMES}")
+        return out
+
+    def feature_points(self, nv: int) -> dict[str, int]:
+        raw = self.get("feature_points", dict)
+        table = feature_point_table()
+        for key in raw:
+            if key not in table:
+                raise self.fail(f"feature_points has unknown feature point {key!r}")
+        missing = [p for p in required_feature_points() if p not in raw]
+        if missing:
+            raise self.fail(f"feature point {missing[0]} is missing"
+                            + (f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""))
+        return {k: self.index(v, nv, f"feature point {k}") for k, v in raw.items()}
+
+    def pivots(self) -> dict[str, np.ndarray]:
+        raw = self.get("pivots", dict)
+        out = {}
+        for name in PIVOTS:
+            value = raw.get(name)
+            if (not isinstance(value, list) or len(value) != 3
+                    or not all(isinstance(c, (int, float)) for c in value)):
+                raise self.fail(f"pivot {name!r} must be three numbers, got {value!r}")
+            out[name] = np.asarray(value, dtype=np.float64)
+        return out
+
+    def neck(self) -> tuple[np.ndarray, np.ndarray, float]:
+        raw = self.get("neck", dict)
+        try:
+            point = np.asarray(raw["point"], dtype=np.float64).reshape(3)
+            normal = np.asarray(raw["normal"], dtype=np.float64).reshape(3)
+            blend = float(raw["blend"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise self.fail(f"neck needs point, normal and blend: {exc}") from exc
+        length = float(np.linalg.norm(normal))
+        if not length > 0 or not blend > 0:
+            raise self.fail(f"neck normal {raw['normal']!r} and blend {blend!r} must be nonzero")
+        return point, normal / length, blend
+
+    def regions(self, nv: int, fps: dict[str, int], pivots: dict[str, np.ndarray]) -> tuple:
+        raw = self.get("regions", list)
+        out, names = [], set()
+        for i, item in enumerate(raw):
+            where = f"regions[{i}]"
+            if not isinstance(item, dict) or not isinstance(item.get("name"), str):
+                raise self.fail(f"{where} must be an object with a name")
+            name = item["name"]
+            where = f"region {name!r}"
+            if name in names:
+                raise self.fail(f"{where} is defined twice")
+            names.add(name)
+            deformer = item.get("deformer")
+            if deformer not in DEFORMERS:
+                raise self.fail(f"{where} has deformer {deformer!r}; known: {DEFORMERS}")
+            controls = item.get("feature_points")
+            if not isinstance(controls, list) or not controls:
+                raise self.fail(f"{where} needs a non-empty list of feature_points")
+            for c in controls:
+                if c not in fps:
+                    raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
+            vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
+            anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors",
+                                   allow_empty=True)
+            weights = np.zeros(0, np.float32)
+            pivot = ""
+            if deformer == "rbf" and len(controls) + anchors.size < 2:
+                raise self.fail(f"{where}: an RBF needs at least two sources")
+            if deformer in ("weights", "eyelid"):
+                if len(controls) != 1:
+                    raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
+                weights = np.asarray(item.get("weights", []), dtype=np.float64)
+                if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
+                    raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
+            if deformer == "eyelid":
+                pivot = item.get("pivot")
+                if pivot not in pivots:
+                    raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
+            out.append(Region(name=name, deformer=deformer, feature_points=tuple(controls),
+                              vertices=vertices, anchors=anchors,
+                              weights=weights.astype(np.float32), pivot=pivot))
+        return tuple(out)

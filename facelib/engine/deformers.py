@@ -1,0 +1,87 @@
+"""Linear deformers of the thesis (section 4.1.4): raised cosine and multiquadric RBF.
+
+Each deformer answers one question: when its control feature points move by
+``(N, 3)`` displacements, how far does each member vertex move? Both are linear in the
+displacements, so each returns a matrix ``M (Vr, N)``: member displacement = ``M @ dFP``
+(the same matrix for x, y and z).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.distance import cdist
+
+from facelib.errors import FaceModelError
+
+__all__ = ["explicit_weights", "raised_cosine_weights", "rbf_weights"]
+
+RAISED_COSINE_W = 0.5
+"""The constant w of eq. 4.7: with 0.5 the feature point itself moves by exactly its dFP."""
+
+
+def raised_cosine_weights(members: np.ndarray, controls: np.ndarray) -> np.ndarray:
+    """Raised-cosine falloff of eq. 4.7, averaged over the controls of the region.
+
+    ``F(v) = [1 + cos(pi * d_v / d_max)] * w * dFP`` with ``w = 0.5``, ``d_v`` the distance of
+    member ``v`` to the control and ``d_max`` the distance of the farthest member. With several
+    controls each column is divided by their number (the thesis averages the cosines).
+
+    Parameters
+    ----------
+    members: (Vr, 3) float, rest positions of the region's vertices.
+    controls: (N, 3) float, rest positions of its feature points.
+
+    Returns
+    -------
+    (Vr, N) float64 weights in [0, 1].
+    """
+    d = cdist(members, controls)
+    d_max = d.max(axis=0)
+    d_max[d_max == 0] = 1.0
+    w = (1.0 + np.cos(np.pi * np.clip(d / d_max, 0.0, 1.0))) * RAISED_COSINE_W
+    return w / controls.shape[0]
+
+
+def explicit_weights(weights: np.ndarray) -> np.ndarray:
+    """Per-vertex weights given in the face definition (one control): ``(Vr,) -> (Vr, 1)``."""
+    return np.asarray(weights, dtype=np.float64)[:, None]
+
+
+def _stiffness(sources: np.ndarray) -> np.ndarray:
+    """Eck's stiffness ``sc_j``: the distance from source j to its nearest other source."""
+    d = cdist(sources, sources)
+    np.fill_diagonal(d, np.inf)
+    return d.min(axis=1)
+
+
+def rbf_weights(members: np.ndarray, controls: np.ndarray, anchors: np.ndarray) -> np.ndarray:
+    """Multiquadric RBF of eq. 4.8-4.10, trained on controls + static anchors.
+
+    The sources are ``S = controls + anchors``; ``H_ij = sqrt(|s_i - s_j|^2 + sc_j^2)`` with
+    ``sc_j`` the distance from ``s_j`` to its nearest other source (eq. 4.8; the seed prints
+    ``sc_j^2 = min |s_j - s_i|``, which is not unit-free, so this follows Eck's definition).
+    The RBF interpolates displacements (anchors move by zero), so a member's displacement is
+    ``h(x) @ H^-1 @ T`` (eq. 4.9-4.10): linear in the control displacements ``T``.
+
+    Parameters
+    ----------
+    members: (Vr, 3) float, rest positions of the vertices to move.
+    controls: (N, 3) float, rest positions of the feature points (they move).
+    anchors: (A, 3) float, rest positions of the static border points.
+
+    Returns
+    -------
+    (Vr, N) float64: member displacement = result @ control displacements.
+    """
+    sources = np.concatenate([controls, anchors])
+    sc = _stiffness(sources)
+    if not np.all(np.isfinite(sc)) or np.any(sc == 0):
+        raise FaceModelError("RBF sources must be at least two distinct points")
+    h = np.sqrt(cdist(sources, sources) ** 2 + sc[None, :] ** 2)
+    hx = np.sqrt(cdist(members, sources) ** 2 + sc[None, :] ** 2)
+    try:
+        # members @ H^-1, restricted to the control columns of T (anchors are zero)
+        m = np.linalg.solve(h.T, hx.T).T
+    except np.linalg.LinAlgError as exc:  # pragma: no cover - multiquadric H is invertible
+        raise FaceModelError(f"RBF matrix is singular: {exc}") from exc
+    return m[:, : controls.shape[0]]

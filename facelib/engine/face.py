@@ -1,0 +1,377 @@
+"""``Face``: a head mesh with its face definition, compiled for deformation by FAPs.
+
+Deformation of one frame ``f`` (84 FAP values):
+
+1. every translational FAP moves its feature point by ``f_j * FAPU_j * direction_j``
+   (eq. 4.6) and the regions controlled by that point carry the motion to their vertices
+   (raised cosine, RBF or explicit weights); all of this is one sparse linear operator
+   ``A (84, 3V)``, so ``positions = rest + f @ A``;
+2. eyelids (FAP 19-22) rotate over the eyeball about the eye centre, by the angle that
+   moves their feature point vertically by ``f_j * IRISD``, each vertex by its weight;
+3. eyeballs rotate about their centres (FAP 23-26) and move forward (FAP 27-28);
+4. lower teeth and tongue follow the jaw: a hinge rotation that drops the chin point 2.1 by
+   ``f_3 * MNS`` plus the thrust (FAP 14) and shift (FAP 15) translations;
+5. the head rotates about its pivot (FAP 48-50), fading to nothing over the neck.
+
+FAPs 1-2 (high-level visemes and expressions, expanded by the generators), 29-30 (pupil
+dilation) and 47 (tongue roll) do not move this mesh.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+import scipy.sparse as sp
+
+from facelib.engine import rigid
+from facelib.engine.deformers import explicit_weights, raised_cosine_weights, rbf_weights
+from facelib.engine.fapu import compute_fapu
+from facelib.errors import FaceModelError, ParameterError
+from facelib.mpeg4.stream import FapStream
+from facelib.mpeg4.tables import N_FAPS, fap, fap_table
+
+__all__ = ["PART_NAMES", "Face", "Part", "Region"]
+
+PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
+LINEAR_DEFORMERS = ("cosine", "rbf", "weights")
+DEFORMERS = (*LINEAR_DEFORMERS, "eyelid")
+_EYELID_FAPS = {"3.1": 19, "3.2": 20, "3.3": 21, "3.4": 22}
+_EYES = (("eye_l", 23, 25, 27), ("eye_r", 24, 26, 28))
+_BLOCK = 32  # frames deformed together
+
+
+def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
+    out = np.array(array, dtype=dtype, copy=True)
+    out.flags.writeable = False
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """A named piece of the mesh.
+
+    name: one of ``PART_NAMES``.
+    vertex_ids: (Vp,) int32 global vertex indices.
+    triangles: (Fp, 3) int32 with global vertex indices.
+    """
+
+    name: str
+    vertex_ids: np.ndarray
+    triangles: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Region:
+    """An influence region of the face definition.
+
+    name: unique name.
+    deformer: ``"cosine"`` (eq. 4.7), ``"rbf"`` (eq. 4.8-4.10), ``"weights"`` (explicit
+        per-vertex weights of one feature point) or ``"eyelid"`` (rotation over the eye).
+    feature_points: ids of the controlling feature points.
+    vertices: (Vr,) int32 member vertices (the ones that move).
+    anchors: (A,) int32 static border vertices (RBF only; empty otherwise).
+    weights: (Vr,) float32 (``weights`` and ``eyelid`` only; empty otherwise).
+    pivot: pivot name (``eyelid`` only).
+    """
+
+    name: str
+    deformer: str
+    feature_points: tuple[str, ...]
+    vertices: np.ndarray
+    anchors: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
+    weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
+    pivot: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class _Rigid:
+    """What steps 2-5 need, precomputed."""
+
+    lids: tuple[tuple[int, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
+    eyes: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, int, int, int], ...]
+    jaw_ids: np.ndarray
+    jaw_pivot: np.ndarray
+    chin: np.ndarray
+    head_pivot: np.ndarray
+    head_tiled: np.ndarray  # (3V,) float32, the pivot repeated per vertex
+    head_weights: np.ndarray
+    neck_ids: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Face:
+    """A deformable head.
+
+    Attributes
+    ----------
+    vertices: (V, 3) float32 neutral positions in the face's length unit (metres for the
+        default head); +x the face's left, +y up, the face looks along +z.
+    triangles: (F, 3) int32, counter-clockwise seen from outside.
+    vertex_colors: (V, 3) float32 RGB in [0, 1].
+    parts: part name -> :class:`Part` (``skin``, ``eye_l``, ``eye_r``, ``teeth_upper``,
+        ``teeth_lower``, ``tongue``).
+    feature_points: feature point id (``"2.1"``) -> vertex index.
+    fapu: ``IRISD``, ``ES``, ``ENS``, ``MNS``, ``MW`` in mesh units per FAP unit, ``AU`` in
+        radians (eq. 4.1-4.5).
+    regions: the influence regions.
+    pivots: ``eye_l``, ``eye_r``, ``head``, ``jaw`` -> (3,) float64 positions.
+    operator: scipy CSR array (84, 3V) float32: vertex displacements (flattened ``(V, 3)``)
+        per FAP unit, for every translational FAP that deforms linearly.
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    vertex_colors: np.ndarray
+    parts: Mapping[str, Part]
+    feature_points: Mapping[str, int]
+    fapu: Mapping[str, float]
+    regions: tuple[Region, ...]
+    pivots: Mapping[str, np.ndarray]
+    operator: sp.csr_array = field(repr=False)
+    _columns: np.ndarray = field(repr=False)
+    _dense: np.ndarray = field(repr=False)
+    _rigid: _Rigid = field(repr=False)
+
+    @classmethod
+    def build(
+        cls,
+        *,
+        vertices: np.ndarray,
+        triangles: np.ndarray,
+        vertex_colors: np.ndarray,
+        parts: Mapping[str, np.ndarray],
+        feature_points: Mapping[str, int],
+        regions: tuple[Region, ...],
+        pivots: Mapping[str, np.ndarray],
+        neck: tuple[np.ndarray, np.ndarray, float],
+    ) -> Face:
+        """Compile a face from validated pieces (see :func:`facelib.engine.load_face`).
+
+        ``parts`` maps part names to (Vp,) vertex ids; ``neck`` is a point, a unit normal
+        (pointing into the head) and a blend distance of the plane where the neck ends.
+        """
+        verts = _readonly(vertices, np.float32)
+        tris = _readonly(triangles, np.int32)
+        fps = MappingProxyType(dict(feature_points))
+        fapu = MappingProxyType(compute_fapu(verts, fps))
+        part_map = {}
+        for name, part_ids in parts.items():
+            ids = _readonly(part_ids, np.int32)
+            inside = np.zeros(len(verts), bool)
+            inside[ids] = True
+            part_map[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+        pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
+        operator = _compile(verts, fps, fapu, regions)
+        for region in regions:
+            for eye in ("eye_l", "eye_r"):
+                if np.isin(region.vertices, part_map[eye].vertex_ids).any():
+                    raise FaceModelError(
+                        f"region {region.name!r} contains vertices of {eye}; eyeballs are "
+                        "rigid and move only with FAP 23-28"
+                    )
+        columns = np.unique(operator.indices).astype(np.int64)
+        dense = operator[:, columns].toarray().astype(np.float32)
+        head = pivot_map["head"]
+        point, normal, blend = neck
+        height = (verts.astype(np.float64) - point) @ normal
+        t = np.clip(height / blend, 0.0, 1.0)
+        head_w = t * t * (3 - 2 * t)
+        rigid_parts = _Rigid(
+            lids=_lids(verts, fps, fapu, regions, pivot_map),
+            eyes=tuple(
+                (part_map[name].vertex_ids.astype(np.int64),
+                 (verts[part_map[name].vertex_ids] - pivot_map[name]).astype(np.float32),
+                 np.tile(pivot_map[name].astype(np.float32), part_map[name].vertex_ids.size),
+                 yaw, pitch, thrust)
+                for name, yaw, pitch, thrust in _EYES
+            ),
+            jaw_ids=np.concatenate(
+                [part_map["teeth_lower"].vertex_ids, part_map["tongue"].vertex_ids]
+            ).astype(np.int64),
+            jaw_pivot=pivot_map["jaw"],
+            chin=verts[fps["2.1"]].astype(np.float64),
+            head_pivot=head,
+            head_tiled=np.tile(head.astype(np.float32), len(verts)),
+            head_weights=head_w[head_w < 1.0].astype(np.float32),
+            neck_ids=np.nonzero(head_w < 1.0)[0],
+        )
+        return cls(
+            vertices=verts,
+            triangles=tris,
+            vertex_colors=_readonly(vertex_colors, np.float32),
+            parts=MappingProxyType(part_map),
+            feature_points=fps,
+            fapu=fapu,
+            regions=tuple(regions),
+            pivots=MappingProxyType(pivot_map),
+            operator=operator,
+            _columns=columns,
+            _dense=dense,
+            _rigid=rigid_parts,
+        )
+
+    @property
+    def n_vertices(self) -> int:
+        return int(self.vertices.shape[0])
+
+    def deform(self, stream: FapStream) -> np.ndarray:
+        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``."""
+        if not isinstance(stream, FapStream):
+            raise ParameterError(f"deform() takes a FapStream, not {type(stream).__name__}")
+        return self._deform(np.asarray(stream.values, dtype=np.float32))
+
+    def deform_frame(self, values: np.ndarray) -> np.ndarray:
+        """Vertex positions for one frame of 84 FAP values: ``(84,) -> (V, 3) float32``."""
+        values = np.asarray(values, dtype=np.float32)
+        if values.shape != (N_FAPS,):
+            raise ParameterError(f"deform_frame() needs 84 FAP values, got shape {values.shape}")
+        if not np.all(np.isfinite(values)):
+            raise ParameterError("deform_frame() got a non-finite FAP value")
+        return self._deform(values[None, :])[0]
+
+    def _deform(self, f: np.ndarray) -> np.ndarray:
+        n, nv = f.shape[0], self.n_vertices
+        out = np.empty((n, nv, 3), np.float32)
+        active = np.flatnonzero(np.any(self._dense != 0, axis=1) & np.any(f != 0, axis=0))
+        # frames go through in small blocks so that every pass stays in the CPU cache
+        buf = np.empty((_BLOCK, nv, 3), np.float32)
+        for a in range(0, n, _BLOCK):
+            fb = f[a : a + _BLOCK]
+            pos = buf[: len(fb)]
+            flat = pos.reshape(len(fb), nv * 3)
+            flat[:] = self.vertices.reshape(-1)
+            if active.size:
+                flat[:, self._columns] += fb[:, active] @ self._dense[active]
+            f64 = fb.astype(np.float64)
+            self._move_lids(pos, f64)
+            self._move_eyes(pos, f64)
+            self._move_jaw(pos, f64)
+            self._move_head(pos, f64, out[a : a + _BLOCK])
+        return out
+
+    def _move_lids(self, pos: np.ndarray, f: np.ndarray) -> None:
+        for fap_index, dy_per_unit, pivot, ids, weights, rest in self._rigid.lids:
+            if not f[:, fap_index].any():
+                continue
+            angle = rigid.hinge_angle(rest, pivot, f[:, fap_index] * dy_per_unit)
+            pos[:, ids] = rigid.rotate_about_x(pos[:, ids], pivot, angle[:, None] * weights)
+
+    def _move_eyes(self, pos: np.ndarray, f: np.ndarray) -> None:
+        au = self.fapu["AU"]
+        for ids, local, tiled, yaw, pitch, thrust in self._rigid.eyes:
+            y, p, t = f[:, yaw - 1] * au, f[:, pitch - 1] * au, f[:, thrust - 1]
+            if not (y.any() or p.any() or t.any()):
+                continue
+            rot = rigid.rotation_matrices(p, y, np.zeros_like(p)).astype(np.float32)
+            # eyeballs are rigid (no region moves them), so start from the rest shape; flat
+            # passes over (n, 3K) are much faster than broadcasting over a last axis of 3
+            moved = np.matmul(local[None], rot.transpose(0, 2, 1))
+            moved.reshape(len(f), -1)[:] += tiled
+            moved[..., 2] += (t * self.fapu["ES"]).astype(np.float32)[:, None]
+            pos[:, ids] = moved
+
+    def _move_jaw(self, pos: np.ndarray, f: np.ndarray) -> None:
+        r = self._rigid
+        open_, thrust, shift = f[:, 2], f[:, 13], f[:, 14]
+        if not (open_.any() or thrust.any() or shift.any()):
+            return
+        angle = rigid.hinge_angle(r.chin, r.jaw_pivot, -open_ * self.fapu["MNS"])
+        local = pos[:, r.jaw_ids]
+        moved = rigid.rotate_about_x(local, r.jaw_pivot, np.broadcast_to(
+            angle[:, None].astype(np.float32), local.shape[:2]))
+        moved[..., 2] += (thrust * self.fapu["MNS"]).astype(np.float32)[:, None]
+        moved[..., 0] -= (shift * self.fapu["MW"]).astype(np.float32)[:, None]
+        pos[:, r.jaw_ids] = moved
+
+    def _move_head(self, pos: np.ndarray, f: np.ndarray, out: np.ndarray) -> None:
+        """Rotate the block ``pos`` about the head pivot into ``out`` (same shape)."""
+        r = self._rigid
+        au = self.fapu["AU"]
+        pitch, yaw, roll = f[:, 47] * au, f[:, 48] * au, f[:, 49] * au
+        if not (pitch.any() or yaw.any() or roll.any()):
+            out[:] = pos
+            return
+        rot = rigid.rotation_matrices(pitch, yaw, roll)
+        neck = pos[:, r.neck_ids]
+        nb = len(f)
+        pos.reshape(nb, -1)[:] -= r.head_tiled
+        np.matmul(pos, rot.transpose(0, 2, 1).astype(np.float32), out=out)
+        out.reshape(nb, -1)[:] += r.head_tiled
+        out[:, r.neck_ids] = rigid.rotate_weighted(neck, r.head_pivot, rot, r.head_weights)
+
+
+def _compile(
+    verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
+    regions: tuple[Region, ...],
+) -> sp.csr_array:
+    """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP."""
+    nv = len(verts)
+    pos = verts.astype(np.float64)
+    # per feature point: list of (member ids, weights) from every linear region it controls
+    carried: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    for region in regions:
+        if region.deformer not in LINEAR_DEFORMERS:
+            continue
+        members = region.vertices.astype(np.int64)
+        controls = pos[[fps[f] for f in region.feature_points]]
+        if region.deformer == "cosine":
+            w = raised_cosine_weights(pos[members], controls)
+        elif region.deformer == "rbf":
+            w = rbf_weights(pos[members], controls, pos[region.anchors])
+        else:
+            w = explicit_weights(region.weights)
+        for k, fp_id in enumerate(region.feature_points):
+            keep = w[:, k] != 0
+            carried.setdefault(fp_id, []).append((members[keep], w[keep, k]))
+    rows, cols, vals = [], [], []
+    for f in fap_table():
+        if f.kind != "translation" or f.fapu not in fapu or f.id in _EYELID_FAPS.values():
+            continue
+        if f.id in (27, 28):  # eyeball thrust moves the whole eye (rigid step)
+            continue
+        fp_id = f.feature_points[0]
+        scale = fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
+        for members, w in carried.get(fp_id, ()):
+            for axis in range(3):
+                if scale[axis] == 0:
+                    continue
+                rows.append(np.full(members.size, f.index))
+                cols.append(members * 3 + axis)
+                vals.append(w * scale[axis])
+    if not rows:
+        return sp.csr_array((N_FAPS, nv * 3), dtype=np.float32)
+    coo = sp.coo_array(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(N_FAPS, nv * 3),
+    )
+    out = coo.tocsr().astype(np.float32)
+    out.sum_duplicates()
+    return out
+
+
+def _lids(
+    verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
+    regions: tuple[Region, ...], pivots: Mapping[str, np.ndarray],
+) -> tuple[tuple[int, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]:
+    out = []
+    for region in regions:
+        if region.deformer != "eyelid":
+            continue
+        fp_id = region.feature_points[0]
+        if fp_id not in _EYELID_FAPS:
+            raise FaceModelError(
+                f"eyelid region {region.name!r} is controlled by {fp_id!r}; "
+                f"eyelid regions take one of {', '.join(_EYELID_FAPS)}"
+            )
+        f = fap(_EYELID_FAPS[fp_id])
+        # the FAP prescribes the vertical motion of the lid point; sliding over the eye,
+        # the rotation decides its depth
+        dy_per_unit = fapu[f.fapu] * f.direction[1]
+        weights = region.weights.astype(np.float64)[None, :]
+        rest = verts[fps[fp_id]].astype(np.float64)
+        out.append((f.index, dy_per_unit, pivots[region.pivot], region.vertices.astype(np.int64),
+                    weights, rest))
+    return tuple(out)

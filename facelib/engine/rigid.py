@@ -1,0 +1,119 @@
+"""Rotations for the rigid and hinged parts: eyeballs, eyelids, jaw, head.
+
+Angles are radians, arrays carry a leading frame axis ``n``. Conventions (face frame: +x the
+face's left, +y up, +z out of the face): a positive rotation about +x turns the front (+z)
+down, about +y turns it to the face's left, about +z tips the top (+y) to the face's right.
+These match the positive directions of FAPs 23-26 and 48-50.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["hinge_angle", "rotate_about_x", "rotate_weighted", "rotation_matrices"]
+
+
+def rotation_matrices(pitch: np.ndarray, yaw: np.ndarray, roll: np.ndarray) -> np.ndarray:
+    """``R = R_y(yaw) @ R_x(pitch) @ R_z(roll)`` per frame.
+
+    Parameters
+    ----------
+    pitch, yaw, roll: (n,) float, radians.
+
+    Returns
+    -------
+    (n, 3, 3) float64.
+    """
+    cp, sp = np.cos(pitch), np.sin(pitch)
+    cy, sy = np.cos(yaw), np.sin(yaw)
+    cr, sr = np.cos(roll), np.sin(roll)
+    n = np.broadcast(pitch, yaw, roll).shape
+    one, zero = np.ones(n), np.zeros(n)
+    rx = np.stack([np.stack([one, zero, zero], -1), np.stack([zero, cp, -sp], -1),
+                   np.stack([zero, sp, cp], -1)], -2)
+    ry = np.stack([np.stack([cy, zero, sy], -1), np.stack([zero, one, zero], -1),
+                   np.stack([-sy, zero, cy], -1)], -2)
+    rz = np.stack([np.stack([cr, -sr, zero], -1), np.stack([sr, cr, zero], -1),
+                   np.stack([zero, zero, one], -1)], -2)
+    return ry @ rx @ rz
+
+
+def hinge_angle(point: np.ndarray, pivot: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """Rotation about the x axis through ``pivot`` that moves ``point`` by ``dy`` vertically.
+
+    The point keeps its distance to the axis, so a target beyond the circle is clamped to the
+    lowest (or highest) point of the circle.
+
+    Parameters
+    ----------
+    point, pivot: (3,) float, positions.
+    dy: (n,) float, the wanted vertical displacement of ``point``.
+
+    Returns
+    -------
+    (n,) float64 angle (positive turns the front down, see :func:`rotate_about_x`).
+    """
+    y, z = float(point[1] - pivot[1]), float(point[2] - pivot[2])
+    rho = np.hypot(y, z)
+    phi = np.arctan2(y, z)
+    target = np.clip((y + np.asarray(dy, dtype=np.float64)) / rho, -1.0, 1.0)
+    return phi - np.arcsin(target)
+
+
+def rotate_about_x(points: np.ndarray, pivot: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rotate points about the x axis through ``pivot``, each by its own angle.
+
+    Parameters
+    ----------
+    points: (n, K, 3) float positions.
+    pivot: (3,) float.
+    angles: (n, K) float radians; positive moves points in front of the pivot down.
+
+    Returns
+    -------
+    (n, K, 3) float, same dtype as ``points``.
+    """
+    angles = np.asarray(angles, dtype=points.dtype)
+    c, s = np.cos(angles), np.sin(angles)
+    y = points[..., 1] - pivot[1]
+    z = points[..., 2] - pivot[2]
+    out = points.copy()
+    out[..., 1] = y * c - z * s + pivot[1]
+    out[..., 2] = y * s + z * c + pivot[2]
+    return out
+
+
+def rotate_weighted(
+    points: np.ndarray, pivot: np.ndarray, rotations: np.ndarray, weights: np.ndarray
+) -> np.ndarray:
+    """Rotate points about ``pivot`` by a fraction ``weights`` of each frame's rotation.
+
+    The fraction scales the rotation angle about the rotation's own axis (Rodrigues' formula),
+    so a weight of 1 applies the full rotation and 0 leaves the point still.
+
+    Parameters
+    ----------
+    points: (n, K, 3) float positions.
+    pivot: (3,) float.
+    rotations: (n, 3, 3) rotation matrices.
+    weights: (K,) float in [0, 1].
+
+    Returns
+    -------
+    (n, K, 3), the dtype of ``points``.
+    """
+    trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(trace)
+    axis = np.stack([rotations[:, 2, 1] - rotations[:, 1, 2],
+                     rotations[:, 0, 2] - rotations[:, 2, 0],
+                     rotations[:, 1, 0] - rotations[:, 0, 1]], -1)
+    norm = np.linalg.norm(axis, axis=1, keepdims=True)
+    axis = np.divide(axis, norm, out=np.zeros_like(axis), where=norm > 1e-15)
+    phi = (angle[:, None] * weights[None, :]).astype(points.dtype)  # (n, K)
+    axis = axis.astype(points.dtype)
+    v = points - pivot.astype(points.dtype)
+    k = axis[:, None, :]
+    kv = np.cross(np.broadcast_to(k, v.shape), v)
+    kdot = (v * k).sum(-1, keepdims=True)
+    c, s = np.cos(phi)[..., None], np.sin(phi)[..., None]
+    return v * c + kv * s + k * kdot * (1.0 - c) + pivot.astype(points.dtype)

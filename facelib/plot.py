@@ -1,0 +1,98 @@
+"""FAP curves over time, one panel per face region, with the storyboard's cues shaded.
+
+Needs matplotlib (the ``plot`` extra); it is imported on first use.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facelib.atomic import atomic_path
+from facelib.errors import MissingExtraError
+from facelib.mpeg4.stream import FapStream
+from facelib.mpeg4.tables import fap
+
+__all__ = ["REGIONS", "plot_curves"]
+
+REGIONS: tuple[tuple[str, tuple[int, ...]], ...] = (
+    ("jaw and inner lips", tuple(range(3, 19))),
+    ("outer lips", tuple(range(51, 61))),
+    ("extended lips and nose", tuple(range(69, 85))),
+    ("eyelids (IRISD)", (19, 20, 21, 22)),
+    ("eyeballs (AU)", tuple(range(23, 31))),
+    ("eyebrows", tuple(range(31, 39))),
+    ("cheeks, nose, ears", (*range(39, 43), *range(61, 69))),
+    ("tongue", tuple(range(43, 48))),
+    ("head (AU)", (48, 49, 50)),
+)
+"""Panels: a title and the FAP ids it shows."""
+
+
+def plot_curves(
+    source: FapStream | Any,
+    out: str | os.PathLike[str],
+    *,
+    title: str | None = None,
+    width: float = 12.0,
+) -> Path:
+    """Plot every FAP of ``source`` that moves over time to an image file (PNG, SVG, PDF).
+
+    source: a FapStream, or an Animation (then its expression and eye cues are shaded and
+        labelled, and the spoken span is marked).
+    out: the file to write (atomically). Returns its path.
+    """
+    try:
+        import matplotlib as mpl
+
+        mpl.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as exc:
+        raise MissingExtraError("plotting", "plot", "matplotlib") from exc
+    stream: FapStream = source if isinstance(source, FapStream) else source.faps
+    storyboard = getattr(source, "storyboard", None)
+    moving = set(np.flatnonzero(stream.values.any(axis=0)) + 1)
+    active = [f for f in stream.active_faps() if f > 2 and f in moving]
+    panels = [(name, [f for f in active if f in ids]) for name, ids in REGIONS]
+    panels = [(name, faps) for name, faps in panels if faps] or [("no active FAPs", [])]
+    fig, axes = plt.subplots(len(panels), 1, sharex=True, squeeze=False,
+                             figsize=(width, 1.9 * len(panels) + 0.8))
+    t = stream.times
+    for ax, (name, faps) in zip(axes[:, 0], panels, strict=True):
+        if storyboard is not None:
+            _shade_cues(ax, storyboard)
+        for f in faps:
+            info = fap(f)
+            ax.plot(t, stream.values[:, f - 1], lw=1.1, label=f"{f} {info.name} ({info.fapu})")
+        ax.set_ylabel(name, fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+        if faps:
+            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    axes[-1, 0].set_xlabel("time (s)")
+    axes[-1, 0].set_xlim(0, max(stream.duration, 1e-3))
+    fig.suptitle(title or f"FAP curves: {stream.n_frames} frames at {stream.fps:g} fps")
+    fig.tight_layout()
+    with atomic_path(out) as temp:
+        fig.savefig(temp, dpi=110, format=Path(out).suffix.lstrip(".") or "png")
+    plt.close(fig)
+    return Path(out)
+
+
+def _shade_cues(ax: Any, storyboard: Any) -> None:
+    colours = {"expression": "tab:orange", "gaze": "tab:blue"}
+    for kind, cues in (("expression", storyboard.expressions), ("gaze", storyboard.gaze)):
+        for cue in cues:
+            start, end = cue.start_ms / 1000, cue.end_ms / 1000
+            ax.axvspan(start, end, color=colours[kind], alpha=0.07, lw=0)
+            label = cue.name if kind == "expression" else cue.behaviour
+            y = 0.95 if kind == "expression" else 0.05
+            ax.text(start, y, label, transform=ax.get_xaxis_transform(), fontsize=6,
+                    color=colours[kind], va="top" if y > 0.5 else "bottom")
+    speech = storyboard.speech
+    if speech is not None and speech.visemes:
+        ax.axvspan(speech.visemes[0].start_ms / 1000, speech.visemes[-1].end_ms / 1000,
+                   color="tab:green", alpha=0.05, lw=0)
