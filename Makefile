@@ -7,7 +7,7 @@ EXTRAS ?= all
 .PHONY: demo test setup lint bench clean
 
 demo: $(VENV)/.installed
-	$(BIN)/facelib info examples/fap/xface_smile.fap
+	$(BIN)/facelib render examples/hello/hello.fdl -o out/hello.mp4 --fap out/hello.fap
 
 test: $(VENV)/.installed
 	$(BIN)/ruff check .

@@ -19,24 +19,32 @@ RAISED_COSINE_W = 0.5
 """The constant w of eq. 4.7: with 0.5 the feature point itself moves by exactly its dFP."""
 
 
-def raised_cosine_weights(members: np.ndarray, controls: np.ndarray) -> np.ndarray:
+def raised_cosine_weights(
+    members: np.ndarray, controls: np.ndarray, *, edge: np.ndarray | None = None
+) -> np.ndarray:
     """Raised-cosine falloff of eq. 4.7, averaged over the controls of the region.
 
     ``F(v) = [1 + cos(pi * d_v / d_max)] * w * dFP`` with ``w = 0.5``, ``d_v`` the distance of
     member ``v`` to the control and ``d_max`` the distance of the farthest member. With several
     controls each column is divided by their number (the thesis averages the cosines).
 
+    A region is seldom a disc around its point: with ``edge`` given, ``d_max`` is instead the
+    distance to the nearest of those edge vertices (members next to the rest of the mesh),
+    and members farther out stay still, so the surface is continuous (with zero slope) where
+    the region meets the rest of the mesh instead of creasing there.
+
     Parameters
     ----------
     members: (Vr, 3) float, rest positions of the region's vertices.
     controls: (N, 3) float, rest positions of its feature points.
+    edge: (E, 3) float, rest positions of the region's edge vertices, or None.
 
     Returns
     -------
     (Vr, N) float64 weights in [0, 1].
     """
     d = cdist(members, controls)
-    d_max = d.max(axis=0)
+    d_max = d.max(axis=0) if edge is None or not len(edge) else cdist(edge, controls).min(axis=0)
     d_max[d_max == 0] = 1.0
     w = (1.0 + np.cos(np.pi * np.clip(d / d_max, 0.0, 1.0))) * RAISED_COSINE_W
     return w / controls.shape[0]

@@ -164,7 +164,7 @@ class Face:
             inside[ids] = True
             part_map[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
-        operator = _compile(verts, fps, fapu, regions)
+        operator = _compile(verts, tris, fps, fapu, regions)
         for region in regions:
             for eye in ("eye_l", "eye_r"):
                 if np.isin(region.vertices, part_map[eye].vertex_ids).any():
@@ -303,9 +303,17 @@ class Face:
         out[:, r.neck_ids] = rigid.rotate_weighted(neck, r.head_pivot, rot, r.head_weights)
 
 
+def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Ids of the members that share a triangle with a vertex outside ``members``."""
+    inside = np.zeros(n_vertices, bool)
+    inside[members] = True
+    mixed = triangles[inside[triangles].any(1) & ~inside[triangles].all(1)]
+    return np.unique(mixed[inside[mixed]])
+
+
 def _compile(
-    verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
-    regions: tuple[Region, ...],
+    verts: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int],
+    fapu: Mapping[str, float], regions: tuple[Region, ...],
 ) -> sp.csr_array:
     """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP."""
     nv = len(verts)
@@ -318,7 +326,8 @@ def _compile(
         members = region.vertices.astype(np.int64)
         controls = pos[[fps[f] for f in region.feature_points]]
         if region.deformer == "cosine":
-            w = raised_cosine_weights(pos[members], controls)
+            edge = pos[_edge(members, triangles, nv)]
+            w = raised_cosine_weights(pos[members], controls, edge=edge)
         elif region.deformer == "rbf":
             w = rbf_weights(pos[members], controls, pos[region.anchors])
         else:

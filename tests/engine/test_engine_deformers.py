@@ -19,6 +19,16 @@ def test_raised_cosine_profile() -> None:
     assert np.all(np.diff(w) <= 0)
 
 
+def test_raised_cosine_falls_to_zero_at_the_region_edge() -> None:
+    """A region that is not a disc: the falloff ends at its nearest edge vertex."""
+    d = np.linspace(0.0, 2.0, 21)
+    members = np.stack([d, np.zeros_like(d), np.zeros_like(d)], 1)
+    edge = np.array([[1.0, 0.0, 0.0]])
+    w = raised_cosine_weights(members, np.zeros((1, 3)), edge=edge)[:, 0]
+    np.testing.assert_allclose(w[:11], (1 + np.cos(np.pi * d[:11])) * 0.5, atol=1e-12)
+    assert not w[10:].any()
+
+
 def test_raised_cosine_averages_several_points() -> None:
     members = np.array([[0.0, 0, 0], [1.0, 0, 0], [0.5, 0, 0]])
     controls = np.array([[0.0, 0, 0], [1.0, 0, 0]])
