@@ -1,0 +1,73 @@
+"""Every example in examples/ runs, and produces what it says."""
+
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from facelib import fap, read_fap, run_fdl
+
+ROOT = Path(__file__).parent.parent
+EXAMPLES = ROOT / "examples"
+
+
+def _quiet_run(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return run_fdl(path)
+
+
+def test_expression_tour_shows_every_expression_in_turn():
+    anim = _quiet_run(EXAMPLES / "tours" / "expressions.fdl")
+    names = [c.name for c in anim.storyboard.expressions]
+    assert len(names) == 11 and len(set(names)) == 11
+    corner = anim.faps.values[:, fap("raise_l_cornerlip").index]
+    assert corner[25] > 100  # joy holds at 1 s
+    assert corner[75] < -100  # sadness at 3 s
+
+
+def test_eye_tour_runs_every_behaviour():
+    anim = _quiet_run(EXAMPLES / "tours" / "eyes.fdl")
+    behaviours = {c.behaviour for c in anim.storyboard.gaze}
+    assert behaviours == {"default", "lookTo", "concentration", "discomfort", "distress",
+                          "ironic", "pursuit"}
+    yaw = anim.faps.values[:, fap("head_yaw").index]
+    assert yaw[int(3.7 * 25)] > 3000  # lookTo left with the head: the head turns left
+
+
+def test_hello_storyboard_speaks_emotes_and_looks():
+    pytest.importorskip("pocketsphinx")
+    anim = _quiet_run(EXAMPLES / "hello" / "hello.fdl")
+    assert anim.audio.name == "hello.flac" and anim.audio_offset == pytest.approx(0.2)
+    shown = {span.name for span in anim.visemes}
+    assert {"PP", "FF", "aa"} <= shown  # "my", "wonderful", "talk"
+    assert anim.visemes[0].start_ms >= 200  # the speech starts at 0.2 s
+    jaw = anim.faps.values[:, fap("open_jaw").index]
+    assert jaw.max() > 300  # the mouth opens while talking
+    blinks = [e for e in anim.gaze_events if type(e).__name__ == "Blink"]
+    assert blinks
+
+
+@pytest.mark.parametrize(
+    ("script", "outputs"),
+    [
+        ("five_lines.py", ["out/hello_api.fap", "out/hello_api.mp4"]),
+        ("follower_eyes.py", ["out/follower_eyes.mp4"]),
+        ("play_xface_fap.py", ["out/xface_smile_standard.fap", "out/xface_smile.mp4"]),
+    ],
+)
+def test_python_examples_run(tmp_path, script, outputs):
+    pytest.importorskip("pyrender")
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    result = subprocess.run([sys.executable, str(EXAMPLES / "python" / script)],
+                            cwd=tmp_path, capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
+    for out in outputs:
+        assert (tmp_path / out).stat().st_size > 1000
+    if script == "play_xface_fap.py":
+        original = read_fap(EXAMPLES / "fap" / "xface_smile.fap")
+        again = read_fap(tmp_path / outputs[0], strict=True)
+        assert np.abs(again.values - original.values).max() <= 0.5
