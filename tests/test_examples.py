@@ -1,5 +1,6 @@
 """Every example in examples/ runs, and produces what it says."""
 
+import importlib.util
 import subprocess
 import sys
 import warnings
@@ -60,7 +61,8 @@ def test_hello_storyboard_speaks_emotes_and_looks():
     ],
 )
 def test_python_examples_run(tmp_path, script, outputs):
-    pytest.importorskip("pyrender")
+    if importlib.util.find_spec("pyrender") is None:  # importing it would pick a GL platform
+        pytest.skip("rendering needs the render extra")
     (tmp_path / "examples").symlink_to(EXAMPLES)
     result = subprocess.run([sys.executable, str(EXAMPLES / "python" / script)],
                             cwd=tmp_path, capture_output=True, text=True, check=False)
