@@ -1,35 +1,23 @@
-"""Viseme names a stored viseme script may use (``facelib/data/fdl/viseme_names.csv``)."""
+"""Viseme names a stored viseme script may use: those of ``facelib.visemes`` (one table,
+``facelib/data/visemes/visemes.csv``), checked with the script's file and line."""
 
 from __future__ import annotations
 
-import csv
-import io
-from functools import cache
-from importlib import resources
-
-from facelib.errors import FdlError
+from facelib.errors import FdlError, ParameterError
 from facelib.fdl.suggest import did_you_mean
+from facelib.visemes.tables import viseme_aliases
+from facelib.visemes.tables import viseme_id as _viseme_id
 
 __all__ = ["check_viseme", "viseme_id"]
 
 
-@cache
-def _names() -> dict[str, int]:
-    text = resources.files("facelib.data").joinpath("fdl/viseme_names.csv").read_text("utf-8")
-    rows = csv.DictReader(
-        io.StringIO("".join(r for r in text.splitlines(keepends=True) if not r.startswith("#")))
-    )
-    names: dict[str, int] = {}
-    for row in rows:
-        number = int(row["id"])
-        for key in (row["id"], row["mpeg4"], row["thesis"]):
-            names[key] = number
-    return names
-
-
 def viseme_id(name: str) -> int | None:
     """MPEG-4 viseme number (0-14) of a thesis name, short name or number; None if unknown."""
-    return _names().get(str(name))
+    text = str(name).strip()
+    try:
+        return _viseme_id(int(text) if text.isdigit() else text)
+    except ParameterError:
+        return None
 
 
 def check_viseme(name: str, *, path: str, line: int | None) -> int:
@@ -37,9 +25,9 @@ def check_viseme(name: str, *, path: str, line: int | None) -> int:
     number = viseme_id(name)
     if number is None:
         raise FdlError(
-            f"unknown viseme {name!r}{did_you_mean(name, _names())} (use the thesis names "
-            "silence pbm fv th td kg ch sz nl r A e I Q U, the short names sil PP FF TH DD kk "
-            "CH SS nn RR aa E ih oh ou, or numbers 0-14)",
+            f"unknown viseme {name!r}{did_you_mean(name, viseme_aliases())} (use the thesis "
+            "names silence pbm fv th td kg ch sz nl r A e I Q U, the short names sil PP FF TH "
+            "DD kk CH SS nn RR aa E ih oh ou, or numbers 0-14)",
             path=path,
             line=line,
         )

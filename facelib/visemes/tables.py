@@ -38,6 +38,7 @@ __all__ = [
     "phone_viseme",
     "script_name",
     "timing_rules",
+    "viseme_aliases",
     "viseme_id",
     "viseme_name",
     "viseme_targets",
@@ -121,6 +122,11 @@ def viseme_name(viseme: int) -> str:
     if not (isinstance(viseme, (int, np.integer)) and 0 <= viseme < N_VISEMES):
         raise ParameterError(f"viseme id must be an integer 0-14, got {viseme!r}")
     return names[int(viseme)]
+
+
+def viseme_aliases() -> Mapping[str, int]:
+    """Every name a script may give a viseme (MPEG-4 and thesis names) -> its id 0-14."""
+    return _viseme_names()[1]
 
 
 def viseme_id(name: str | int) -> int:
