@@ -12,7 +12,7 @@ from typing import Any
 
 import facelib
 from facelib.errors import FacelibError
-from facelib.mpeg4 import fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
 
 __all__ = ["main"]
 
@@ -59,21 +59,19 @@ def _animation(path: str, seed: int | None) -> Any:
     return run_fdl(path, seed=seed)
 
 
-def _write_fap(animation: Any, out: str | Path | None, dialect: str) -> Path | None:
-    target = out if out is not None else animation.storyboard.output
-    if target is None:
-        return None
-    written = write_fap(animation.faps, target, dialect=dialect)
-    print(f"wrote {written} ({animation.faps.n_frames} frames, {animation.faps.duration:.2f} s)")
-    return written
+def _write_fap(stream: FapStream, out: str | Path, dialect: str) -> None:
+    written = write_fap(stream, out, dialect=dialect)
+    print(f"wrote {written} ({stream.n_frames} frames, {stream.duration:.2f} s)")
 
 
 def _run(args: argparse.Namespace) -> int:
     from facelib.animation import run_fdl
 
     animation = run_fdl(args.story, seed=args.seed)
-    if _write_fap(animation, args.output, args.dialect) is None:
+    out = args.output if args.output is not None else animation.storyboard.output
+    if out is None:
         raise FacelibError(f"{args.story} names no output: give one with -o OUT.fap")
+    _write_fap(animation.faps, out, args.dialect)
     return 0
 
 
@@ -84,10 +82,9 @@ def _render(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     source = _animation(args.source, args.seed)
     if args.fap is not None:
-        _write_fap(source, args.fap, "standard")
-    audio = getattr(args, "audio", None)
+        _write_fap(source if isinstance(source, FapStream) else source.faps, args.fap, "standard")
     out = render(source, face=load_face(args.face), out=args.output, width=args.width,
-                 height=args.height, audio=audio, fps=args.fps)
+                 height=args.height, audio=args.audio, fps=args.fps)
     print(f"wrote {out} in {time.perf_counter() - started:.1f} s")
     return 0
 
@@ -158,7 +155,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_render_options(render)
     render.add_argument("--fap", help="also write the animation's .fap here")
     render.add_argument("--seed", type=int)
-    render.set_defaults(run=_render)
+    render.set_defaults(run=_render, audio=None)
 
     play = commands.add_parser("play", help="render a .fap file, with optional audio")
     play.add_argument("source", metavar="FILE.fap")

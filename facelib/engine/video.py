@@ -20,6 +20,7 @@ from typing import Protocol
 import numpy as np
 
 from facelib.errors import MissingExtraError, ParameterError, RenderError
+from facelib.mpeg4.stream import check_fps
 
 __all__ = [
     "FrameWriter",
@@ -256,8 +257,7 @@ def open_writer(
     """
     path = Path(path)
     suffix = path.suffix.lower()
-    if not (isinstance(fps, (int, float)) and np.isfinite(fps) and fps > 0):
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    check_fps(fps)
     if audio is not None and suffix != ".mp4":
         raise ParameterError(f"audio can only be muxed into .mp4, not {path.name!r}")
     if suffix == ".mp4":

@@ -20,6 +20,7 @@ from facelib.gaze.events import Blink, HeadMove, Saccade
 from facelib.gaze.model import gaze_model
 from facelib.gaze.motion import Motion
 from facelib.gaze.planner import Planner
+from facelib.mpeg4.stream import check_fps
 from facelib.mpeg4.tables import ANGLE_UNIT, N_FAPS
 from facelib.mpeg4.track import FapTrack
 
@@ -69,8 +70,7 @@ class GazeAnimation:
 
 
 def _check_frames(fps: float, n_frames: int) -> None:
-    if not (isinstance(fps, (int, float)) and np.isfinite(fps) and fps > 0):
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    check_fps(fps)
     if not isinstance(n_frames, (int, np.integer)) or n_frames < 0:
         raise ParameterError(f"n_frames must be an integer >= 0, got {n_frames!r}")
 

@@ -30,7 +30,6 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 
@@ -41,7 +40,6 @@ from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
 __all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
 
-Dialect = Literal["standard", "xface", "greta", "vreng", "extended"]
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _WRITE_DIALECTS = ("standard", "xface", "greta", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1

@@ -11,13 +11,23 @@ import numpy as np
 from facelib.errors import ParameterError
 from facelib.mpeg4.tables import N_FAPS
 
-__all__ = ["EXPRESSION_FIELDS", "VISEME_FIELDS", "FapStream"]
+__all__ = ["EXPRESSION_FIELDS", "VISEME_FIELDS", "FapStream", "check_fps"]
 
 VISEME_FIELDS = ("select1", "select2", "blend", "def")
 """Columns of ``FapStream.viseme`` (FAP 1): two viseme ids 0-14, blend 0-63, def flag."""
 EXPRESSION_FIELDS = ("select1", "intensity1", "select2", "intensity2", "init_face", "def")
 """Columns of ``FapStream.expression`` (FAP 2): two expression ids 0-6 with intensities
 0-63, init_face and def flags."""
+
+
+def check_fps(fps: object) -> float:
+    """``fps`` as a float; ``ParameterError`` unless it is a finite number > 0."""
+    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.number)):
+        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    value = float(fps)
+    if not np.isfinite(value) or value <= 0:
+        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    return value
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -56,9 +66,7 @@ class FapStream:
     expression: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        fps = float(self.fps) if isinstance(self.fps, (int, float, np.number)) else None
-        if fps is None or not np.isfinite(fps) or fps <= 0:
-            raise ParameterError(f"fps must be a positive number, got {self.fps!r}")
+        fps = check_fps(self.fps)
         values = np.asarray(self.values)
         if values.ndim != 2 or values.shape[1] != N_FAPS:
             raise ParameterError(f"values must have shape (n_frames, {N_FAPS}), got {values.shape}")
@@ -152,10 +160,12 @@ class FapStream:
             raise ParameterError(f"bad time span [{start}, {stop}) seconds")
         return self[max(first, 0) : min(last, self.n_frames)]
 
-    def _take(self, index: Any, fps: float) -> FapStream:
+    def _take(self, index: Any, fps: float, *, values: np.ndarray | None = None) -> FapStream:
+        """Frames ``index`` (a slice or an index array) at ``fps``, optionally with new
+        ``values`` for them."""
         return FapStream(
             fps,
-            self.values[index],
+            self.values[index] if values is None else values,
             self.mask[index],
             None if self.viseme is None else self.viseme[index],
             None if self.expression is None else self.expression[index],
@@ -167,8 +177,7 @@ class FapStream:
         FAP values are interpolated linearly in time between neighbouring frames; the mask
         and the high-level FAP 1/2 fields come from the nearest earlier frame.
         """
-        if not (isinstance(fps, (int, float)) and np.isfinite(fps) and fps > 0):
-            raise ParameterError(f"fps must be a positive number, got {fps!r}")
+        fps = check_fps(fps)
         n_out = max(round(self.duration * fps), 1 if self.n_frames else 0)
         if self.n_frames == 0:
             return FapStream.zeros(0, fps=fps)
@@ -179,8 +188,7 @@ class FapStream:
         w = (src - lo)[:, None].clip(0, 1)
         both = self.mask[lo] & self.mask[hi]
         values = np.where(both, (1 - w) * self.values[lo] + w * self.values[hi], self.values[lo])
-        out = self._take(lo, fps)
-        return FapStream(fps, values, out.mask, out.viseme, out.expression)
+        return self._take(lo, fps, values=values)
 
     @staticmethod
     def concat(streams: Iterable[FapStream]) -> FapStream:

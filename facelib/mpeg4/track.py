@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from facelib.errors import ParameterError
+from facelib.mpeg4.stream import check_fps
 from facelib.mpeg4.tables import N_FAPS
 
 __all__ = ["FapTrack"]
@@ -34,8 +35,7 @@ class FapTrack:
     weight: np.ndarray
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.fps, (int, float)) and np.isfinite(self.fps) and self.fps > 0):
-            raise ParameterError(f"fps must be a positive number, got {self.fps!r}")
+        object.__setattr__(self, "fps", check_fps(self.fps))
         values = np.asarray(self.values, dtype=np.float32)
         weight = np.asarray(self.weight, dtype=np.float32)
         if values.ndim != 2 or values.shape[1] != N_FAPS:
@@ -52,7 +52,6 @@ class FapTrack:
             frozen = array.copy()
             frozen.flags.writeable = False
             object.__setattr__(self, name, frozen)
-        object.__setattr__(self, "fps", float(self.fps))
 
     @classmethod
     def empty(cls, n_frames: int, *, fps: float) -> FapTrack:
