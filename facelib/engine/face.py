@@ -86,19 +86,54 @@ class Region:
     pivot: str = ""
 
 
+def _columns(ids: np.ndarray, axes: str = "xyz") -> np.ndarray:
+    """Columns of the given vertices' coordinates in flattened ``(V, 3)`` positions.
+
+    ``ids`` (K,) -> (K * len(axes),) int64, vertex-major. Gathers and scatters through
+    these columns of ``(n, 3V)`` blocks are many times faster than indexing the vertex axis
+    of ``(n, V, 3)`` arrays.
+    """
+    offsets = np.array(["xyz".index(a) for a in axes], np.int64)
+    return (np.asarray(ids, np.int64)[:, None] * 3 + offsets).ravel()
+
+
+@dataclass(frozen=True, eq=False)
+class _Lids:
+    """The eyelid regions merged into one rotation: rotations about one axis add, so a
+    vertex turns by the weighted sum of its regions' hinge angles.
+
+    hinges: per region (FAP index, vertical motion of its feature point per FAP unit, pivot
+        (3,), feature point rest position (3,)).
+    y, z: (K,) int64 columns (see :func:`_columns`) of the eyelid vertices.
+    pivot_y, pivot_z: (K,) float32, each vertex's eye centre.
+    weights: (R, K) float64, each region's weight of each vertex.
+    """
+
+    hinges: tuple[tuple[int, float, np.ndarray, np.ndarray], ...]
+    y: np.ndarray
+    z: np.ndarray
+    pivot_y: np.ndarray
+    pivot_z: np.ndarray
+    weights: np.ndarray
+
+
 @dataclass(frozen=True, eq=False)
 class _Rigid:
-    """What steps 2-5 need, precomputed."""
+    """What steps 2-5 need, precomputed; vertex sets as columns (see :func:`_columns`)."""
 
-    lids: tuple[tuple[int, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
+    lids: _Lids
+    # per eye: columns (3K,), rest shape about the centre (K, 3) float32, the centre
+    # repeated (3K,) float32, FAP numbers of yaw, pitch and thrust
     eyes: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, int, int, int], ...]
-    jaw_ids: np.ndarray
+    jaw_x: np.ndarray
+    jaw_y: np.ndarray
+    jaw_z: np.ndarray
     jaw_pivot: np.ndarray
     chin: np.ndarray
     head_pivot: np.ndarray
     head_tiled: np.ndarray  # (3V,) float32, the pivot repeated per vertex
-    head_weights: np.ndarray
-    neck_ids: np.ndarray
+    head_weights: np.ndarray  # (K,) float32 for the neck vertices
+    neck: np.ndarray  # (3K,) columns
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,24 +214,26 @@ class Face:
         height = (verts.astype(np.float64) - point) @ normal
         t = np.clip(height / blend, 0.0, 1.0)
         head_w = t * t * (3 - 2 * t)
+        jaw_ids = np.concatenate(
+            [part_map["teeth_lower"].vertex_ids, part_map["tongue"].vertex_ids])
         rigid_parts = _Rigid(
             lids=_lids(verts, fps, fapu, regions, pivot_map),
             eyes=tuple(
-                (part_map[name].vertex_ids.astype(np.int64),
+                (_columns(part_map[name].vertex_ids),
                  (verts[part_map[name].vertex_ids] - pivot_map[name]).astype(np.float32),
                  np.tile(pivot_map[name].astype(np.float32), part_map[name].vertex_ids.size),
                  yaw, pitch, thrust)
                 for name, yaw, pitch, thrust in _EYES
             ),
-            jaw_ids=np.concatenate(
-                [part_map["teeth_lower"].vertex_ids, part_map["tongue"].vertex_ids]
-            ).astype(np.int64),
+            jaw_x=_columns(jaw_ids, "x"),
+            jaw_y=_columns(jaw_ids, "y"),
+            jaw_z=_columns(jaw_ids, "z"),
             jaw_pivot=pivot_map["jaw"],
             chin=verts[fps["2.1"]].astype(np.float64),
             head_pivot=head,
             head_tiled=np.tile(head.astype(np.float32), len(verts)),
             head_weights=head_w[head_w < 1.0].astype(np.float32),
-            neck_ids=np.nonzero(head_w < 1.0)[0],
+            neck=_columns(np.nonzero(head_w < 1.0)[0]),
         )
         return cls(
             vertices=verts,
@@ -253,38 +290,42 @@ class Face:
         return out
 
     def _move_lids(self, pos: np.ndarray, f: np.ndarray) -> None:
-        for fap_index, dy_per_unit, pivot, ids, weights, rest in self._rigid.lids:
-            if not f[:, fap_index].any():
-                continue
-            angle = rigid.hinge_angle(rest, pivot, f[:, fap_index] * dy_per_unit)
-            pos[:, ids] = rigid.rotate_about_x(pos[:, ids], pivot, angle[:, None] * weights)
+        lids = self._rigid.lids
+        angles = np.zeros((len(f), len(lids.hinges)))
+        for k, (fap_index, dy_per_unit, pivot, rest) in enumerate(lids.hinges):
+            if f[:, fap_index].any():
+                angles[:, k] = rigid.hinge_angle(rest, pivot, f[:, fap_index] * dy_per_unit)
+        if not angles.any():
+            return
+        flat = pos.reshape(len(f), -1)
+        flat[:, lids.y], flat[:, lids.z] = rigid.rotate_about_x(
+            flat[:, lids.y], flat[:, lids.z], lids.pivot_y, lids.pivot_z, angles @ lids.weights)
 
     def _move_eyes(self, pos: np.ndarray, f: np.ndarray) -> None:
         au = self.fapu["AU"]
-        for ids, local, tiled, yaw, pitch, thrust in self._rigid.eyes:
+        flat = pos.reshape(len(f), -1)
+        for columns, local, tiled, yaw, pitch, thrust in self._rigid.eyes:
             y, p, t = f[:, yaw - 1] * au, f[:, pitch - 1] * au, f[:, thrust - 1]
             if not (y.any() or p.any() or t.any()):
                 continue
             rot = rigid.rotation_matrices(p, y, np.zeros_like(p)).astype(np.float32)
-            # eyeballs are rigid (no region moves them), so start from the rest shape; flat
-            # passes over (n, 3K) are much faster than broadcasting over a last axis of 3
+            # eyeballs are rigid (no region moves them), so start from the rest shape
             moved = np.matmul(local[None], rot.transpose(0, 2, 1))
-            moved.reshape(len(f), -1)[:] += tiled
             moved[..., 2] += (t * self.fapu["ES"]).astype(np.float32)[:, None]
-            pos[:, ids] = moved
+            flat[:, columns] = moved.reshape(len(f), -1) + tiled
 
     def _move_jaw(self, pos: np.ndarray, f: np.ndarray) -> None:
         r = self._rigid
         open_, thrust, shift = f[:, 2], f[:, 13], f[:, 14]
         if not (open_.any() or thrust.any() or shift.any()):
             return
+        flat = pos.reshape(len(f), -1)
         angle = rigid.hinge_angle(r.chin, r.jaw_pivot, -open_ * self.fapu["MNS"])
-        local = pos[:, r.jaw_ids]
-        moved = rigid.rotate_about_x(local, r.jaw_pivot, np.broadcast_to(
-            angle[:, None].astype(np.float32), local.shape[:2]))
-        moved[..., 2] += (thrust * self.fapu["MNS"]).astype(np.float32)[:, None]
-        moved[..., 0] -= (shift * self.fapu["MW"]).astype(np.float32)[:, None]
-        pos[:, r.jaw_ids] = moved
+        y, z = rigid.rotate_about_x(flat[:, r.jaw_y], flat[:, r.jaw_z], r.jaw_pivot[1],
+                                    r.jaw_pivot[2], angle[:, None])
+        flat[:, r.jaw_y] = y
+        flat[:, r.jaw_z] = z + (thrust * self.fapu["MNS"]).astype(np.float32)[:, None]
+        flat[:, r.jaw_x] -= (shift * self.fapu["MW"]).astype(np.float32)[:, None]
 
     def _move_head(self, pos: np.ndarray, f: np.ndarray, out: np.ndarray) -> None:
         """Rotate the block ``pos`` about the head pivot into ``out`` (same shape)."""
@@ -294,13 +335,15 @@ class Face:
         if not (pitch.any() or yaw.any() or roll.any()):
             out[:] = pos
             return
-        rot = rigid.rotation_matrices(pitch, yaw, roll)
-        neck = pos[:, r.neck_ids]
         nb = len(f)
-        pos.reshape(nb, -1)[:] -= r.head_tiled
+        rot = rigid.rotation_matrices(pitch, yaw, roll)
+        flat = pos.reshape(nb, -1)
+        neck = flat[:, r.neck].reshape(nb, -1, 3)
+        flat -= r.head_tiled
         np.matmul(pos, rot.transpose(0, 2, 1).astype(np.float32), out=out)
         out.reshape(nb, -1)[:] += r.head_tiled
-        out[:, r.neck_ids] = rigid.rotate_weighted(neck, r.head_pivot, rot, r.head_weights)
+        out.reshape(nb, -1)[:, r.neck] = rigid.rotate_weighted(
+            neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
 
 
 def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.ndarray:
@@ -364,23 +407,33 @@ def _compile(
 def _lids(
     verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
     regions: tuple[Region, ...], pivots: Mapping[str, np.ndarray],
-) -> tuple[tuple[int, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]:
-    out = []
-    for region in regions:
-        if region.deformer != "eyelid":
-            continue
+) -> _Lids:
+    lid_regions = [r for r in regions if r.deformer == "eyelid"]
+    ids = np.unique(np.concatenate([r.vertices for r in lid_regions] + [np.zeros(0, np.int32)]))
+    weights = np.zeros((len(lid_regions), ids.size))
+    pivot_of = np.full(ids.size, "", dtype=object)
+    hinges = []
+    for k, region in enumerate(lid_regions):
         fp_id = region.feature_points[0]
         if fp_id not in _EYELID_FAPS:
             raise FaceModelError(
                 f"eyelid region {region.name!r} is controlled by {fp_id!r}; "
                 f"eyelid regions take one of {', '.join(_EYELID_FAPS)}"
             )
+        at = np.searchsorted(ids, region.vertices)
+        clash = (pivot_of[at] != "") & (pivot_of[at] != region.pivot)
+        if clash.any():
+            raise FaceModelError(
+                f"eyelid region {region.name!r} shares vertex {int(ids[at[clash][0]])} with "
+                f"an eyelid region about another pivot than {region.pivot!r}"
+            )
+        pivot_of[at] = region.pivot
+        weights[k, at] = region.weights
         f = fap(_EYELID_FAPS[fp_id])
         # the FAP prescribes the vertical motion of the lid point; sliding over the eye,
         # the rotation decides its depth
-        dy_per_unit = fapu[f.fapu] * f.direction[1]
-        weights = region.weights.astype(np.float64)[None, :]
-        rest = verts[fps[fp_id]].astype(np.float64)
-        out.append((f.index, dy_per_unit, pivots[region.pivot], region.vertices.astype(np.int64),
-                    weights, rest))
-    return tuple(out)
+        hinges.append((f.index, fapu[f.fapu] * f.direction[1], pivots[region.pivot],
+                       verts[fps[fp_id]].astype(np.float64)))
+    centres = np.array([pivots[name] for name in pivot_of], np.float32).reshape(-1, 3)
+    return _Lids(tuple(hinges), _columns(ids, "y"), _columns(ids, "z"), centres[:, 1],
+                 centres[:, 2], weights)

@@ -60,27 +60,26 @@ def hinge_angle(point: np.ndarray, pivot: np.ndarray, dy: np.ndarray) -> np.ndar
     return phi - np.arcsin(target)
 
 
-def rotate_about_x(points: np.ndarray, pivot: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rotate points about the x axis through ``pivot``, each by its own angle.
+def rotate_about_x(
+    y: np.ndarray, z: np.ndarray, pivot_y: np.ndarray, pivot_z: np.ndarray, angles: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Rotate points about x axes through pivots, each point by its own angle.
 
     Parameters
     ----------
-    points: (n, K, 3) float positions.
-    pivot: (3,) float.
+    y, z: (n, K) float coordinates of the points.
+    pivot_y, pivot_z: scalars, or (K,) with a pivot per point.
     angles: (n, K) float radians; positive moves points in front of the pivot down.
 
     Returns
     -------
-    (n, K, 3) float, same dtype as ``points``.
+    The rotated ``(y, z)``, each (n, K) in the dtype of ``y``.
     """
-    angles = np.asarray(angles, dtype=points.dtype)
+    angles = np.asarray(angles, dtype=y.dtype)
     c, s = np.cos(angles), np.sin(angles)
-    y = points[..., 1] - pivot[1]
-    z = points[..., 2] - pivot[2]
-    out = points.copy()
-    out[..., 1] = y * c - z * s + pivot[1]
-    out[..., 2] = y * s + z * c + pivot[2]
-    return out
+    y = y - pivot_y
+    z = z - pivot_z
+    return y * c - z * s + pivot_y, y * s + z * c + pivot_z
 
 
 def rotate_weighted(
@@ -104,16 +103,23 @@ def rotate_weighted(
     """
     trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     angle = np.arccos(trace)
-    axis = np.stack([rotations[:, 2, 1] - rotations[:, 1, 2],
-                     rotations[:, 0, 2] - rotations[:, 2, 0],
-                     rotations[:, 1, 0] - rotations[:, 0, 1]], -1)
-    norm = np.linalg.norm(axis, axis=1, keepdims=True)
-    axis = np.divide(axis, norm, out=np.zeros_like(axis), where=norm > 1e-15)
+    x, y, z = (rotations[:, 2, 1] - rotations[:, 1, 2], rotations[:, 0, 2] - rotations[:, 2, 0],
+               rotations[:, 1, 0] - rotations[:, 0, 1])
+    norm = np.sqrt(x * x + y * y + z * z)
+    scale = np.divide(1.0, norm, out=np.zeros_like(norm), where=norm > 1e-15)
+    x, y, z = x * scale, y * scale, z * scale
+    zero = np.zeros_like(x)
+    # v @ cross[i] is axis[i] x v
+    cross = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
+                      np.stack([y, -x, zero], -1)], -2).astype(points.dtype)
     phi = (angle[:, None] * weights[None, :]).astype(points.dtype)  # (n, K)
-    axis = axis.astype(points.dtype)
-    v = points - pivot.astype(points.dtype)
-    k = axis[:, None, :]
-    kv = np.cross(np.broadcast_to(k, v.shape), v)
-    kdot = (v * k).sum(-1, keepdims=True)
-    c, s = np.cos(phi)[..., None], np.sin(phi)[..., None]
-    return v * c + kv * s + k * kdot * (1.0 - c) + pivot.astype(points.dtype)
+    pivot = np.asarray(pivot, dtype=points.dtype)
+    v = points - pivot
+    kv = v @ cross
+    kkv = kv @ cross  # axis x (axis x v)
+    kv *= np.sin(phi)[..., None]
+    kkv *= (1.0 - np.cos(phi))[..., None]
+    v += kv
+    v += kkv
+    v += pivot
+    return v

@@ -84,6 +84,12 @@ def _lid_pivot(d: dict) -> None:
     next(r for r in d["regions"] if r["deformer"] == "eyelid")["pivot"] = "nose"
 
 
+def _lids_share(d: dict) -> None:
+    lids = {r["name"]: r for r in d["regions"] if r["deformer"] == "eyelid"}
+    lids["upper_lid_l"]["vertices"].append(lids["upper_lid_r"]["vertices"][0])
+    lids["upper_lid_l"]["weights"].append(0.5)
+
+
 @pytest.mark.parametrize(("edit", "match"), [
     (_del_fp, "feature point 2.3 is missing"),
     (_fp_range, "feature point 4.1 is 10000000"),
@@ -97,6 +103,7 @@ def _lid_pivot(d: dict) -> None:
     (_bad_part, r"parts\['eye_l'\]"),
     (_version, "version 99"),
     (_lid_pivot, "pivot 'nose'"),
+    (_lids_share, "about another pivot"),
 ])
 def test_broken_definition_names_the_item(tmp_path: Path, edit, match: str) -> None:
     path = broken(tmp_path, edit)
