@@ -15,8 +15,11 @@ What it does:
    ends in one straight, clean edge;
 2. replaces the 72-vertex helper eyes by finer spheres of the same centre and radius whose
    vertex colours draw sclera, iris and pupil with crisp ring borders;
-3. keeps the helper teeth and tongue; converts everything to metres with the origin at the head
-   pivot (the MakeHuman ``joint-head`` marker, at the base of the skull);
+3. keeps the helper teeth and tongue, the tongue lowered to rest behind the lower incisors;
+   converts everything to metres with the origin at the head pivot (the MakeHuman
+   ``joint-head`` marker, at the base of the skull); closes the resting lips, which the base
+   mesh leaves a millimetre apart; paints the mouth cavity, teeth and tongue darker with depth
+   (the renderer has no ambient occlusion);
 4. places the MPEG-4 feature points with geometric rules, helped by the ARKit face targets of
    the same wheel (which vertices a jaw opening, a blink, a brow raise moves);
 5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots.
@@ -47,6 +50,11 @@ JAW_ZERO, JAW_ONE = 0.32, 0.62
 SKIN = (0.87, 0.68, 0.57)
 LIP = (0.74, 0.40, 0.40)
 MOUTH = (0.42, 0.16, 0.17)
+LIP_SEAL, LIP_BAND = 0.0008, 0.004  # closing the resting lips (metres)
+TONGUE_DROP_DEG, TONGUE_BACK = 6.0, 0.05  # lowering the tongue (degrees, decimetres)
+# no ambient occlusion in the renderer: the cavity, tongue and teeth darken with depth to
+# these fractions of their colour within MOUTH_FADE metres behind their front
+MOUTH_DEEP, TEETH_DEEP, MOUTH_FADE = 0.25, 0.45, 0.025
 SCLERA = (0.96, 0.95, 0.93)
 IRIS = (0.30, 0.45, 0.55)
 IRIS_RIM = (0.12, 0.18, 0.22)
@@ -190,6 +198,39 @@ def eye_sphere(centre: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarra
     return np.array(verts), np.array(tris), np.array(cols)
 
 
+def seal_lips(pos: np.ndarray, skin: np.ndarray, lower: np.ndarray, *, mouth_y: float,
+              x_corner: float, front_z: float) -> None:
+    """Close the base mesh's resting lips in place (``pos`` in metres).
+
+    MakeHuman's lips rest about a millimetre apart, so the teeth show through a bright slit
+    and lip-closing FAPs leave it open toward the corners. Each lip's band next to the
+    contact line moves toward the other by ``LIP_SEAL`` (fading to nothing ``LIP_BAND``
+    away from the line and at the corners), so the lips meet with a slight overlap.
+    """
+    ids = skin[pos[skin, 2] > front_z - 0.003]
+    dy = pos[ids, 1] - mouth_y
+    near = np.clip(1.0 - np.abs(dy) / LIP_BAND, 0.0, 1.0)
+    lateral = np.clip(1.0 - (np.abs(pos[ids, 0]) / (1.08 * x_corner)) ** 8, 0.0, 1.0)
+    toward = np.where(lower[ids], 1.0, -1.0)
+    pos[ids, 1] += toward * LIP_SEAL * near * lateral
+
+
+def rest_tongue(verts: np.ndarray, root: np.ndarray) -> np.ndarray:
+    """The helper tongue lowered to rest on the floor of the mouth.
+
+    MakeHuman's tongue presses its tip against the back of the upper incisors, level with
+    their edges, so any jaw opening shows a wall of tongue. A tongue at rest lies behind
+    the lower incisors: turn it front-down about its root (``joint-tongue-1``) and draw it
+    back a little (units: decimetres, the base mesh's).
+    """
+    angle = np.radians(TONGUE_DROP_DEG)
+    c, s = np.cos(angle), np.sin(angle)
+    rel = verts - root
+    y = rel[:, 1] * c - rel[:, 2] * s
+    z = rel[:, 1] * s + rel[:, 2] * c
+    return root + np.stack([rel[:, 0], y, z - TONGUE_BACK], 1)
+
+
 def orient_outward(verts: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """Flip triangles of a closed-ish part so that normals point away from its centroid."""
     a, b, c = (verts[tris[:, i]] for i in range(3))
@@ -257,6 +298,7 @@ def build(wheel_path: Path) -> None:
         return base_v[ids], orient_outward(base_v[ids], tris)
 
     teeth_u, teeth_l, tongue = helper("upper-teeth"), helper("lower-teeth"), helper("tongue")
+    tongue = (rest_tongue(tongue[0], joint["tongue-1"]), tongue[1])
 
     parts_src = [
         ("skin", skin_v, skin_t, None),
@@ -280,6 +322,12 @@ def build(wheel_path: Path) -> None:
     for name, colour in (("teeth_upper", TEETH), ("teeth_lower", TEETH), ("tongue", TONGUE)):
         a, b = ranges[name]
         cols[a:b] = colour
+    # teeth and tongue darken toward the back, out of the light that enters the mouth
+    for name, deep in (("teeth_upper", TEETH_DEEP), ("teeth_lower", TEETH_DEEP),
+                       ("tongue", MOUTH_DEEP)):
+        a, b = ranges[name]
+        back = np.clip((verts[a:b, 2].max() - verts[a:b, 2]) / MOUTH_FADE, 0.0, 1.0)[:, None]
+        cols[a:b] *= 1.0 - (1.0 - deep) * back
     skin = np.arange(n_skin)
     pos = verts  # metres, origin at the head pivot
 
@@ -317,6 +365,8 @@ def build(wheel_path: Path) -> None:
     tgt = pos[corner_l] + [-0.002, 0.0, 0.0]
     fp["2.4"] = int(band[np.argmin(np.linalg.norm(pos[band] - tgt, axis=1))])
     x_corner = float(pos[corner_l, 0])
+    seal_lips(pos, skin, lower_frac >= SPLIT, mouth_y=mouth_y, x_corner=x_corner,
+              front_z=float(pos[corner_l, 2]))
     for side, sgn in (("l", 1.0), ("r", -1.0)):
         xt = sgn * 0.5 * x_corner
         col = skin[np.abs(pos[skin, 0] - xt) < 0.0015]
@@ -451,7 +501,7 @@ def build(wheel_path: Path) -> None:
     # ---- tongue
     ta, tb = ranges["tongue"]
     tv = np.arange(ta, tb)
-    centre_line = tv[np.abs(pos[tv, 0]) < 0.003]
+    centre_line = tv[np.abs(pos[tv, 0]) < 1e-4]  # on the plane of symmetry: the tongue bends evenly
     fp["6.1"] = pick(centre_line, pos[:, 2], "tongue tip")
     zc = pos[tv, 2].mean()
     fp["6.2"] = pick(
@@ -476,13 +526,13 @@ def build(wheel_path: Path) -> None:
         pos,
         skin_t,
         n_skin,
-        blocked=on_lip
-        | (pos[skin, 2] > pos[fp["8.3"], 2] - 0.002)
-        | (np.abs(pos[skin, 0]) > x_corner + 0.004)
-        | (np.abs(pos[skin, 1] - mouth_y) > 0.03),
-        seed=int(mid[np.argmin(np.abs(pos[mid, 1] - mouth_y) + pos[mid, 2])]),
+        blocked=on_lip | (pos[skin, 2] > pos[fp["8.3"], 2] - 0.002),
+        # the wall nearest to a point in the middle of the cavity, above the tongue
+        seed=int(skin[np.argmin(np.linalg.norm(pos[skin] - [0.0, mouth_y, 0.09], axis=1))]),
     )
-    skin_c[inside] = MOUTH
+    # the cavity darkens with depth behind the lips
+    depth = np.clip((pos[fp["8.3"], 2] - pos[skin[inside], 2]) / MOUTH_FADE, 0.0, 1.0)[:, None]
+    skin_c[inside] = np.array(MOUTH) * (1.0 - (1.0 - MOUTH_DEEP) * depth)
     cols[:n_skin] = skin_c
 
     regions = make_regions(

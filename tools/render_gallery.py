@@ -43,11 +43,11 @@ def main(folder: str) -> None:
     with FaceRenderer(face, width=300, height=340) as renderer:
         pictures = [_label(renderer.frame(face.deform_frame(v)), k) for k, v in poses.items()]
         save_png(_sheet(pictures, 4), out / "expressions.png")
-    with FaceRenderer(face, width=300, height=340) as renderer:
-        mouth = []
-        for vid, values in enumerate(viseme_targets()):
-            image = renderer.frame(face.deform_frame(values))
-            mouth.append(_label(image[170:320, 60:240], f"{vid} {viseme_name(vid)}"))
+    fp = face.feature_points
+    around_mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "9.15", "2.1")]]
+    with FaceRenderer(face, width=240, height=180, framing=around_mouth) as renderer:
+        mouth = [_label(renderer.frame(face.deform_frame(values)), f"{vid} {viseme_name(vid)}")
+                 for vid, values in enumerate(viseme_targets())]
         save_png(_sheet(mouth, 5), out / "visemes.png")
 
 

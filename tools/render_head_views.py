@@ -37,7 +37,7 @@ POSES: dict[str, dict[str, float]] = {
     "speech 'oo'": {"open_jaw": 250, "push_b_lip": 200, "push_t_lip": 200,
                     "stretch_l_cornerlip_o": -250, "stretch_r_cornerlip_o": -250,
                     "stretch_l_cornerlip": -250, "stretch_r_cornerlip": -250},
-    "tongue out": {"open_jaw": 700, "thrust_tongue_tip": 500, "raise_tongue_tip": 150},
+    "tongue out": {"open_jaw": 700, "thrust_tongue_tip": 500, "raise_tongue_tip": 750},
 }
 
 

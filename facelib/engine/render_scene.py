@@ -171,25 +171,32 @@ def vertex_normals(
 
 
 def frame_camera(
-    vertices: np.ndarray, *, aspect: float, yfov: float, margin: float
+    vertices: np.ndarray, *, aspect: float, yfov: float, margin: float,
+    scene_vertices: np.ndarray | None = None,
 ) -> tuple[np.ndarray, float, float]:
     """Camera pose looking along -z at the face's bounding box, filling the frame.
 
     Returns ``(pose (4, 4) float64, znear, zfar)``; lengths in the face's units. The camera
-    sits on the +z side (the face looks along +z), centred on the box, far enough that the
-    box times ``margin`` fits both the vertical field of view ``yfov`` (radians) and the
-    horizontal one given by ``aspect`` = width / height.
+    sits on the +z side (the face looks along +z), centred on the box of ``vertices``
+    ``(N, 3)``, far enough that the box times ``margin`` fits both the vertical field of
+    view ``yfov`` (radians) and the horizontal one given by ``aspect`` = width / height.
+    The clipping planes enclose the bounding sphere of ``scene_vertices`` (default:
+    ``vertices``) with room to spare for head motion, so framing a close-up (the mouth)
+    never clips what lies behind it (the mouth cavity).
     """
     lo, hi = np.min(vertices, axis=0), np.max(vertices, axis=0)
     centre = (lo + hi) / 2.0
     half = (hi - lo) / 2.0 * margin
     tan_y = np.tan(yfov / 2.0)
-    depth = max(half[2], 1e-6)
     distance = max(half[1] / tan_y, half[0] / (tan_y * aspect), 1e-6) + half[2]
     pose = np.eye(4)
     pose[:3, 3] = (centre[0], centre[1], centre[2] + distance)
-    znear = max(distance - 4.0 * depth, distance * 0.05)
-    zfar = distance + 4.0 * depth
+    everything = vertices if scene_vertices is None else scene_vertices
+    s_lo, s_hi = np.min(everything, axis=0), np.max(everything, axis=0)
+    radius = max(float(np.linalg.norm(s_hi - s_lo)) / 2.0, 1e-6)
+    reach = float(np.linalg.norm(pose[:3, 3] - (s_lo + s_hi) / 2.0))
+    znear = max(reach - 1.5 * radius, reach * 0.01)
+    zfar = reach + 1.5 * radius
     return pose, float(znear), float(zfar)
 
 
@@ -357,7 +364,8 @@ class FaceRenderer:
         yfov = np.radians(self.look.yfov_deg)
         frame_on = vertices if framing is None else np.asarray(framing, np.float32)
         pose, znear, zfar = frame_camera(
-            frame_on, aspect=self.width / self.height, yfov=yfov, margin=self.look.margin
+            frame_on, aspect=self.width / self.height, yfov=yfov, margin=self.look.margin,
+            scene_vertices=vertices,
         )
         camera = pr.PerspectiveCamera(
             yfov=yfov, aspectRatio=self.width / self.height, znear=znear, zfar=zfar

@@ -101,8 +101,10 @@ def test_translation_fap_moves_its_point(face: Face, fap_id: int) -> None:
             np.linalg.norm(rest[p] - centre), rel=1e-5)
     else:
         assert delta == pytest.approx(expected, rel=0.01, abs=1e-3 * np.abs(expected).max())
-    # far from the feature point nothing moves
+    # far from the feature point nothing moves (but the jaw carries teeth and tongue)
     far = np.linalg.norm(rest - rest[p], axis=1) > 0.09
+    if fap_id in (3, 14, 15):
+        far[face.parts["teeth_lower"].vertex_ids] = far[face.parts["tongue"].vertex_ids] = False
     assert np.abs(moved[far] - rest[far]).max() < 1e-7
 
 
@@ -185,6 +187,44 @@ def test_lips_part_by_the_jaw_displacement(face: Face) -> None:
         ids = face.parts[part].vertex_ids
         dy = (moved[ids, 1] - face.vertices[ids, 1]).mean()
         assert (dy < -0.3 * drop) if moves else dy == 0
+
+
+def _incisal_edges(face: Face, moved: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(y, z) of the upper and the lower front teeth's edges (|x| < 4 mm)."""
+    out = []
+    for part, edge in (("teeth_upper", np.argmin), ("teeth_lower", np.argmax)):
+        ids = face.parts[part].vertex_ids
+        ids = ids[np.abs(moved[ids, 0]) < 0.004]
+        out.append(moved[ids[edge(moved[ids, 1])], 1:])
+    return out[0], out[1]
+
+
+def test_tongue_rests_low_and_th_puts_its_tip_between_the_teeth(face: Face) -> None:
+    from facelib.visemes import viseme_targets
+    from facelib.visemes.tables import viseme_id
+
+    tip = face.feature_points["6.1"]
+    upper, lower = _incisal_edges(face, face.vertices)
+    tongue = face.parts["tongue"].vertex_ids
+    # at rest the tongue lies behind the front teeth, its top below the upper teeth's edge
+    assert face.vertices[tongue, 2].max() < lower[1] - 0.005
+    front = tongue[face.vertices[tongue, 2] > lower[1] - 0.015]
+    assert face.vertices[front, 1].max() < upper[0] - 0.002
+    # 'th': the tip comes forward past the lower teeth, between the two rows' edges
+    moved = face.deform_frame(viseme_targets()[viseme_id("TH")])
+    upper, lower = _incisal_edges(face, moved)
+    assert moved[tip, 2] > lower[1]
+    assert lower[0] - 0.003 < moved[tip, 1] < upper[0]
+
+
+def test_mouth_cavity_is_dark(face: Face) -> None:
+    skin = face.parts["skin"].vertex_ids
+    v, corner = face.vertices, face.vertices[face.feature_points["8.3"]]
+    mouth_y = (v[face.feature_points["2.2"], 1] + v[face.feature_points["2.3"], 1]) / 2
+    deep = skin[(v[skin, 2] < corner[2] - 0.01) & (v[skin, 2] > corner[2] - 0.05)
+                & (np.abs(v[skin, 0]) < 0.02) & (np.abs(v[skin, 1] - mouth_y) < 0.03)]
+    assert deep.size > 10
+    assert face.vertex_colors[deep].max() < 0.3
 
 
 def test_eyelids_close_over_the_eye_without_cutting_it(face: Face) -> None:

@@ -57,3 +57,50 @@ def test_eyes_turned_left_move_the_iris_right_in_the_image(head):
     # FAP 23/24 positive turns the eyes to the face's own left, the image's right
     assert x_left > x0 + 1.5
     assert x_right < x0 - 1.5
+
+
+def test_open_mouth_close_up_shows_a_dark_cavity_not_the_background():
+    """Framing the mouth alone must not clip the cavity behind it (the far plane follows
+    the whole head), and the cavity is painted dark."""
+    face = engine.load_face(None)
+    fp = face.feature_points
+    mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "8.1", "2.1")]]
+    with FaceRenderer(face, width=W, height=H, framing=mouth) as renderer:
+        moved = face.deform_frame(_faps(f3=900))
+        image = renderer.frame(moved).astype(int)
+        background = np.asarray(renderer.look.background) * 255
+        # the opening: between the lip midpoints, inward of the corners
+        (_, uy), (_, ly) = renderer.project(moved[[fp["2.2"], fp["2.3"]]])
+        (cl, _), (cr, _) = renderer.project(moved[[fp["2.4"], fp["2.5"]]])
+    rows = slice(int(uy) + 2, int(ly) - 1)
+    cols = slice(int(min(cl, cr)) + 4, int(max(cl, cr)) - 3)
+    opening = image[rows, cols]
+    assert opening.shape[0] > 3
+    assert not np.any(np.abs(opening - background).sum(axis=2) < 12)
+    assert np.percentile(opening.sum(axis=2), 25) < 250  # a dark cavity shows
+
+
+def test_resting_and_bilabial_lips_hide_the_teeth():
+    """Closed lips meet: no tooth shows through a slit (teeth painted green to find them)."""
+    import dataclasses
+
+    from facelib.visemes import viseme_targets
+    from facelib.visemes.tables import viseme_id
+
+    face = engine.load_face(None)
+    colours = np.array(face.vertex_colors)
+    for part in ("teeth_upper", "teeth_lower"):
+        colours[face.parts[part].vertex_ids] = (0.0, 1.0, 0.0)
+    painted = dataclasses.replace(face, vertex_colors=colours)
+    fp = face.feature_points
+    mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "8.1", "2.1")]]
+    with FaceRenderer(painted, width=400, height=300, framing=mouth) as renderer:
+        for values in (np.zeros(84, np.float32), viseme_targets()[viseme_id("PP")],
+                       viseme_targets()[viseme_id("E")]):
+            image = renderer.frame(face.deform_frame(values)).astype(int)
+            teeth = ((image[..., 1] > image[..., 0] + 40)
+                     & (image[..., 1] > image[..., 2] + 40)).sum()
+            if values.any() and values[2] > 300:  # 'E' opens the mouth: the check sees teeth
+                assert teeth > 500
+            else:
+                assert teeth < 60
