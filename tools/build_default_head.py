@@ -275,12 +275,14 @@ def build(wheel_path: Path) -> None:
         return int(found[0])
 
     # per-skin-vertex target displacements (zero for the cut points)
-    def skin_target(name: str) -> np.ndarray:
+    def skin_target(name: str, *, vectors: bool = False) -> np.ndarray:
+        """(n_skin,) displacement magnitudes of an ARKit target (decimetres), or with
+        ``vectors`` the (n_skin, 3) displacements in metres."""
         d = wheel.target(name, n_all)
         out = np.zeros((n_skin, 3))
         ok = skin_src >= 0
         out[ok] = d[skin_src[ok]]
-        return np.linalg.norm(out, axis=1)
+        return out * SCALE if vectors else np.linalg.norm(out, axis=1)
 
     # ---- eyes
     eyes = {}
@@ -607,6 +609,15 @@ def sphere(pos: np.ndarray, cands: np.ndarray, centre_vertex: int, radius: float
     return cands[np.linalg.norm(pos[cands] - pos[centre_vertex], axis=1) < radius]
 
 
+def blink_angle(pos: np.ndarray, motion: np.ndarray, centre: np.ndarray,
+                ids: np.ndarray) -> np.ndarray:
+    """Angle (radians, positive down) by which a target turns vertices ``ids`` about the
+    x axis through ``centre``; ``motion`` (n_skin, 3) displacements in metres."""
+    rest = pos[ids] - centre
+    moved = rest + motion[ids]
+    return np.arctan2(rest[:, 1], rest[:, 2]) - np.arctan2(moved[:, 1], moved[:, 2])
+
+
 def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_corner, eyes):
     regions = []
 
@@ -716,8 +727,11 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
         upper = near[
             (mag[near] > 0.04 * mag[fp[up_fp]]) & (pos[near, 1] > pos[fp[lo_fp], 1] + 0.0005)
         ]
-        # a little more than the blink target near the corners, so the lid closes all along
-        wu = np.clip(mag[upper] / mag[fp[up_fp]], 0, 1) ** 0.75
+        # each vertex turns by its share of the lid point's angle in the ARKit blink, so the
+        # lid closes all along its margin, into the inner corner
+        wu = np.clip(blink_angle(pos, skin_target(blink, vectors=True), centre, upper)
+                     / blink_angle(pos, skin_target(blink, vectors=True), centre,
+                                   np.array([fp[up_fp]]))[0], 0, 1)
         regions.append(
             {
                 "name": f"upper_lid_{side}",

@@ -104,3 +104,20 @@ def test_resting_and_bilabial_lips_hide_the_teeth():
                 assert teeth > 500
             else:
                 assert teeth < 60
+
+
+def test_closed_lids_cover_the_whole_eye():
+    """A blink hides the sclera right into the corners (white pixels of a close-up)."""
+    face = engine.load_face(None)
+    fp = face.feature_points
+    lids = face.vertices[[fp[k] for k in ("3.1", "3.2", "3.3", "3.4")]]
+    side = np.array([0.012, 0.0, 0.0])
+    around = np.vstack([lids + side, lids - side])
+    closed = _faps(f19=1024, f20=1024)
+    with FaceRenderer(face, width=400, height=150, framing=around) as renderer:
+        white = []
+        for values in (_faps(), closed):
+            image = renderer.frame(face.deform_frame(values)).astype(int)
+            white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
+    assert white[0] > 500
+    assert white[1] < 0.03 * white[0]
