@@ -1,10 +1,12 @@
 """Forced alignment of speech audio to its transcript, and phone-loop recognition, with
 pocketsphinx (the ``speech`` extra): audio -> phone and word timelines -> visemes.
 
-Two passes: the words are aligned first (``set_align_text``), then the phones inside them
-(``set_alignment``). Words missing from the dictionary get a letter-to-sound pronunciation.
-A transcript that does not match the audio either fails to align (:class:`SpeechError`) or
-aligns implausibly; the plausibility checks then warn or raise naming the word.
+Two passes on 5 ms frames: the words are aligned first (``set_align_text``), then the phones
+inside them (``set_alignment``); inside each word, boundaries at transitions where the aligner
+is systematically early or late are shifted by a fixed amount (``alignment.json``). Words
+missing from the dictionary get a letter-to-sound pronunciation. A transcript that does not
+match the audio either fails to align (:class:`SpeechError`) or aligns implausibly; the
+plausibility checks then warn or raise naming the word.
 """
 
 from __future__ import annotations
@@ -54,8 +56,10 @@ def _decoder(*, wide: bool = False) -> Any:
         from facelib.errors import MissingExtraError
 
         raise MissingExtraError("speech alignment", "speech", "pocketsphinx") from exc
-    beams = alignment_settings()["wide_beams"] if wide else {}
-    decoder = Decoder(bestpath=False, loglevel="FATAL", **beams)
+    settings = alignment_settings()
+    beams = settings["wide_beams"] if wide else {}
+    decoder = Decoder(bestpath=False, loglevel="FATAL", frate=1000 // settings["frame_ms"],
+                      wlen=settings["window_ms"] / 1000, **beams)
     decoder.add_allphone_file(_PHONE_LOOP, str(model_dir() / "en-us-phone.lm.bin"))
     return decoder
 
@@ -170,15 +174,35 @@ def _forced_with(
         start = to_ms(word_start)
         end = to_ms(word_phones[-1][1] + word_phones[-1][2]) if word_phones else start
         _append(word_spans, SILENCE if is_sil else name, start, end)
-        for label, p_start, p_dur, _ in word_phones:
-            shown = SILENCE if (is_sil or label in _NOISE) else label
-            _append(phone_spans, shown, to_ms(p_start), to_ms(p_start + p_dur))
+        spans = [(SILENCE if (is_sil or label in _NOISE) else label, to_ms(p_start),
+                  to_ms(p_start + p_dur)) for label, p_start, p_dur, _ in word_phones]
+        for label, p_start, p_end in _shift_boundaries(spans, settings):
+            _append(phone_spans, label, p_start, p_end)
         if not is_sil:
             final = k + 1 == n_entries or entries[k + 1][0] in _NOISE
             problems += _check_word(name, word_phones, settings, name in guessed, final=final)
         else:
             problems += _check_pause(word_spans, word_phones, settings)
     return _cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems
+
+
+def _shift_boundaries(
+    phones: Sequence[tuple[str, int, int]], settings: dict[str, Any]
+) -> list[tuple[str, int, int]]:
+    """The phones ``(label, start_ms, end_ms)`` of one word with the boundary between two
+    phones moved by ``boundary_shift_ms["CLASS CLASS"]`` of their ``phone_classes`` (ms,
+    positive: later; the aligner's systematic bias at vowel -> nasal, nasal -> stop and
+    liquid -> vowel transitions). Each phone keeps at least ``min_phone_ms``."""
+    classes = {p: c for c, members in settings["phone_classes"].items() for p in members}
+    shifts, min_ms = settings["boundary_shift_ms"], settings["min_phone_ms"]
+    out = list(phones)
+    for i in range(1, len(out)):
+        (a, a_start, _), (b, b_start, b_end) = out[i - 1], out[i]
+        shift = shifts.get(f"{classes.get(a)} {classes.get(b)}", 0)
+        t = min(max(b_start + shift, a_start + min_ms), b_end - min_ms)
+        if shift and a_start + min_ms <= t:
+            out[i - 1], out[i] = (a, a_start, t), (b, t, b_end)
+    return out
 
 
 def _check_word(
@@ -242,6 +266,7 @@ def _phone_loop(pcm: bytes, duration_ms: int) -> tuple[Span, ...]:
 
 
 def _frame_to_ms(duration_ms: int) -> Any:
+    """Frame index (of the padded audio) -> ms in the audio, clipped to [0, duration_ms]."""
     settings = alignment_settings()
     pad, frame = settings["pad_ms"], settings["frame_ms"]
 
