@@ -1,10 +1,12 @@
 """Forced alignment of speech audio to its transcript, and phone-loop recognition, with
 pocketsphinx (the ``speech`` extra): audio -> phone and word timelines -> visemes.
 
-Two passes: the words are aligned first (``set_align_text``), then the phones inside them
-(``set_alignment``). Words missing from the dictionary get a letter-to-sound pronunciation.
-A transcript that does not match the audio either fails to align (:class:`SpeechError`) or
-aligns implausibly; the plausibility checks then warn or raise naming the word.
+Two passes on 5 ms frames: the words are aligned first (``set_align_text``), then the phones
+inside them (``set_alignment``); inside each word, boundaries at transitions where the aligner
+is systematically early or late are shifted by a fixed amount (``alignment.json``). Words
+missing from the dictionary get a letter-to-sound pronunciation. A transcript that does not
+match the audio either fails to align (:class:`SpeechError`) or aligns implausibly; the
+plausibility checks then warn or raise naming the word.
 """
 
 from __future__ import annotations
@@ -264,6 +266,7 @@ def _phone_loop(pcm: bytes, duration_ms: int) -> tuple[Span, ...]:
 
 
 def _frame_to_ms(duration_ms: int) -> Any:
+    """Frame index (of the padded audio) -> ms in the audio, clipped to [0, duration_ms]."""
     settings = alignment_settings()
     pad, frame = settings["pad_ms"], settings["frame_ms"]
 

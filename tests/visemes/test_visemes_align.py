@@ -25,6 +25,7 @@ def load_truth(name: str) -> tuple[str, list[tuple[str, float]]]:
 
 
 def onset_errors(name: str) -> np.ndarray:
+    """|aligned - true| phone onsets in whole ms (Festival's times are multiples of 5 ms)."""
     text, truth = load_truth(name)
     with warnings.catch_warnings():
         warnings.simplefilter("error", SpeechWarning)  # a correct transcript is plausible
@@ -33,7 +34,7 @@ def onset_errors(name: str) -> np.ndarray:
     got = [p for p in timeline.phones if p.label != "SIL"]
     matcher = difflib.SequenceMatcher(a=[t[0] for t in truth], b=[p.label for p in got],
                                       autojunk=False)
-    errors = [got[b.b + i].start_ms / 1000 - truth[b.a + i][1]
+    errors = [got[b.b + i].start_ms - round(1000 * truth[b.a + i][1])
               for b in matcher.get_matching_blocks() for i in range(b.size)]
     assert len(errors) >= 0.85 * len(truth)
     return np.abs(np.array(errors))
@@ -41,9 +42,11 @@ def onset_errors(name: str) -> np.ndarray:
 
 @pytest.mark.parametrize("name", ["quick_fox", "oov_names"])
 def test_phone_onsets_match_festival_truth(name):
-    err = onset_errors(name)
-    assert np.mean(err <= 0.050) >= 0.9
-    assert np.median(err) <= 0.020
+    err = onset_errors(name)  # measured: within 20 ms 100 % / 91 %, mean 6.5 / 9.1 ms
+    assert np.mean(err <= 20) >= 0.85
+    assert np.mean(err <= 50) >= 0.95
+    assert np.median(err) <= 10
+    assert err.mean() <= 12
 
 
 def test_oov_words_get_guessed_pronunciations():
