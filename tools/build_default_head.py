@@ -729,9 +729,9 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
         ]
         # each vertex turns by its share of the lid point's angle in the ARKit blink, so the
         # lid closes all along its margin, into the inner corner
-        wu = np.clip(blink_angle(pos, skin_target(blink, vectors=True), centre, upper)
-                     / blink_angle(pos, skin_target(blink, vectors=True), centre,
-                                   np.array([fp[up_fp]]))[0], 0, 1)
+        motion = skin_target(blink, vectors=True)
+        angles = blink_angle(pos, motion, centre, np.append(upper, fp[up_fp]))
+        wu = np.clip(angles[:-1] / angles[-1], 0, 1)
         regions.append(
             {
                 "name": f"upper_lid_{side}",

@@ -69,7 +69,8 @@ def rotate_about_x(
     ----------
     y, z: (n, K) float coordinates of the points.
     pivot_y, pivot_z: scalars, or (K,) with a pivot per point.
-    angles: (n, K) float radians; positive moves points in front of the pivot down.
+    angles: (n, K) float radians, or (n, 1) for one angle per frame; positive moves points
+        in front of the pivot down.
 
     Returns
     -------
