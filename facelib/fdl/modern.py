@@ -112,12 +112,24 @@ def _table(
     return arg
 
 
-def _name(arg: LuaTable, fn: str, ctx: Context, line: int | None) -> str:
+def _name(
+    arg: LuaTable, fn: str, ctx: Context, line: int | None, *, named: str | None = None
+) -> str:
+    """The name that opens ``fn { "name", ... }``. With ``named`` (what the rest must be,
+    e.g. "times and intensity (at = ..., dur = ...)"), nothing but named fields may follow."""
     if not arg.items or not isinstance(arg.items[0], str) or not arg.items[0].strip():
         raise FdlError(
             f'{fn} needs a name first, like {fn} {{ "joy", ... }}', path=ctx.path, line=line
         )
-    return arg.items[0]
+    name = arg.items[0]
+    if named is not None and len(arg.items) > 1:
+        raise FdlError(
+            f"{fn} {{ {name!r}, ... }}: unexpected value {arg.items[1]!r} after the name; "
+            f"give {named} as named fields",
+            path=ctx.path,
+            line=line,
+        )
+    return name
 
 
 def _time(value: object, what: str, ctx: Context, line: int | None) -> int:
@@ -132,14 +144,7 @@ def _opt_time(
 
 def _show(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
     t = _table(arg, "show", ctx, line, allowed=_SHOW_FIELDS)
-    name = _name(t, "show", ctx, line)
-    if len(t.items) > 1:
-        raise FdlError(
-            f"show {{ {name!r}, ... }}: unexpected value {t.items[1]!r} after the name; "
-            "give times and intensity as named fields (at = ..., dur = ...)",
-            path=ctx.path,
-            line=line,
-        )
+    name = _name(t, "show", ctx, line, named="times and intensity (at = ..., dur = ...)")
     if "dur" not in t.fields:
         raise FdlError(f"show {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
     duration = _time(t.fields["dur"], "show: dur", ctx, line)
@@ -279,14 +284,8 @@ def _define_expression(arg: object, ctx: Context, line: int | None, parts: Moder
     if not isinstance(arg, LuaTable):
         _table(arg, "define_expression", ctx, line, allowed=())
     t: LuaTable = arg  # type: ignore[assignment]
-    name = _name(t, "define_expression", ctx, line)
-    if len(t.items) > 1:
-        raise FdlError(
-            f"define_expression {{ {name!r} }}: give FAP values as named fields "
-            "(raise_l_cornerlip_o = 120)",
-            path=ctx.path,
-            line=line,
-        )
+    name = _name(t, "define_expression", ctx, line,
+                 named="FAP values (raise_l_cornerlip_o = 120)")
     valid = {f.name: f for f in fap_table() if f.kind != "special"}
     values: dict[str, float] = {}
     mix: dict[str, float] = {}
@@ -367,13 +366,7 @@ def _define_gaze(arg: object, ctx: Context, line: int | None, parts: ModernParts
     if not isinstance(arg, LuaTable):
         _table(arg, "define_gaze", ctx, line, allowed=())
     t: LuaTable = arg  # type: ignore[assignment]
-    name = _name(t, "define_gaze", ctx, line)
-    if len(t.items) > 1:
-        raise FdlError(
-            f"define_gaze {{ {name!r} }}: give parameters as named fields (rate = 2.0)",
-            path=ctx.path,
-            line=line,
-        )
+    name = _name(t, "define_gaze", ctx, line, named="parameters (rate = 2.0)")
     params: dict[str, Any] = {}
     for key, value in t.fields.items():
         if isinstance(value, str | bool | int | float):
