@@ -47,10 +47,10 @@ def main() -> None:
     width, height = (int(v) for v in args.size.split("x"))
 
     from facelib.engine import load_face
-    from facelib.engine.render import render
-    from facelib.engine.render_backend import choose_platform
-    from facelib.engine.render_scene import FaceRenderer
     from facelib.mpeg4.fapfile import read_fap, write_fap
+    from facelib.rendering.frames import render
+    from facelib.rendering.platform import choose_platform
+    from facelib.rendering.scene import FaceRenderer
 
     face = load_face(None)
     stream = _stream(args.seconds, 25)

@@ -31,7 +31,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from visemes_festival import synthesize
 
-from facelib.visemes.align import _decoder, align
+from facelib.speech.align import _decoder
+from facelib.visemes import align
 
 SENTENCES = (  # Harvard sentences (IEEE 1969), lists 1-2: the tuning set
     "The birch canoe slid on the smooth planks.",

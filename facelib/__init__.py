@@ -33,10 +33,10 @@ from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, wri
 __version__ = "0.1.0"
 
 _LAZY = {
-    "render": "facelib.engine.render",
-    "render_still": "facelib.engine.render",
-    "save_png": "facelib.engine.render",
-    "view": "facelib.engine.viewer",
+    "render": "facelib.rendering.frames",
+    "render_still": "facelib.rendering.frames",
+    "save_png": "facelib.rendering.frames",
+    "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
 }
 

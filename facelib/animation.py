@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from facelib import expressions, gaze, visemes
-from facelib.fdl import Storyboard, load
+from facelib.cues import Storyboard
+from facelib.fdl import load
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.sync import SyncRules, combine

@@ -77,7 +77,7 @@ def _run(args: argparse.Namespace) -> int:
 
 def _render(args: argparse.Namespace) -> int:
     from facelib.engine import load_face
-    from facelib.engine.render import render
+    from facelib.rendering.frames import render
 
     started = time.perf_counter()
     source = _animation(args.source, args.seed)
@@ -91,7 +91,7 @@ def _render(args: argparse.Namespace) -> int:
 
 def _view(args: argparse.Namespace) -> int:
     from facelib.engine import load_face
-    from facelib.engine.viewer import view
+    from facelib.rendering.viewer import view
 
     view(_animation(args.source, args.seed), face=load_face(args.face), loop=args.loop)
     return 0

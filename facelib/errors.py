@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 __all__ = [
+    "DataError",
     "FaceModelError",
     "FacelibError",
     "FacelibWarning",
@@ -19,6 +20,7 @@ __all__ = [
     "ParameterError",
     "RenderError",
     "SpeechError",
+    "SpeechWarning",
 ]
 
 
@@ -50,6 +52,10 @@ class FacelibError(Exception):
 
 class ParameterError(FacelibError, ValueError):
     """A value passed to a facelib function is out of range or of the wrong kind."""
+
+
+class DataError(FacelibError):
+    """A data file (package data or a user's rules file) is missing or malformed."""
 
 
 class FapFormatError(FacelibError):
@@ -84,3 +90,7 @@ class MissingExtraError(FacelibError, ImportError):
 
 class FacelibWarning(UserWarning):
     """Something was accepted but looked irregular (e.g. frames missing from a ``.fap``)."""
+
+
+class SpeechWarning(FacelibWarning):
+    """An alignment succeeded but looks implausible (named word, reason)."""

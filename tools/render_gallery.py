@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from facelib.engine import load_face
-from facelib.engine.render_scene import FaceRenderer
-from facelib.engine.video import save_png
 from facelib.expressions import default_library
+from facelib.rendering.scene import FaceRenderer
+from facelib.rendering.video import save_png
 from facelib.visemes import viseme_name, viseme_targets
 
 

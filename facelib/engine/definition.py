@@ -39,6 +39,11 @@ def _default_path() -> Path:
     return Path(str(resources.files("facelib.data").joinpath("head", "default_head.json")))
 
 
+def default_face() -> Face:
+    """facelib's default head (metres), loaded and compiled: ``load_face(None)``."""
+    return load_face(None)
+
+
 def load_face(path: str | Path | None = None) -> Face:
     """Load a face definition and its mesh, validate them and compile the deformers.
 

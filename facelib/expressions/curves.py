@@ -7,9 +7,10 @@ from typing import Literal
 
 import numpy as np
 
+from facelib.checks import check_count, check_fps
+from facelib.cues import ExpressionCue
 from facelib.errors import FdlError, ParameterError
 from facelib.expressions.library import ExpressionLibrary, default_library
-from facelib.fdl.storyboard import ExpressionCue
 from facelib.mpeg4.tables import N_FAPS
 from facelib.mpeg4.track import FapTrack
 
@@ -82,6 +83,8 @@ def animate(
 
     Returns a :class:`FapTrack` of ``n_frames`` at ``fps``.
     """
+    fps = check_fps(fps)
+    n_frames = check_count("n_frames", n_frames)
     library = library or default_library()
     importance = importance or {}
     times = np.arange(n_frames) * (1000.0 / fps)

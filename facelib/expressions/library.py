@@ -17,8 +17,8 @@ from types import MappingProxyType
 
 import numpy as np
 
+from facelib.cues import Origin
 from facelib.errors import FdlError, ParameterError
-from facelib.fdl.storyboard import Origin
 from facelib.mpeg4.tables import N_FAPS, fap
 
 __all__ = ["Expression", "ExpressionLibrary", "default_library"]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from facelib.fdl.storyboard import Origin, Storyboard
+from facelib.cues import Origin, Storyboard
 
 __all__ = ["describe"]
 

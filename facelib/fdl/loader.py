@@ -13,12 +13,12 @@ import math
 from pathlib import Path
 from typing import Any
 
+from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard, VisemeCue
 from facelib.errors import FdlError
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.modern import FUNCTIONS, DraftCue, DraftSpeech, ModernParts, read_calls
 from facelib.fdl.paths import read_text, resolve_inside
 from facelib.fdl.sandbox import WHITELIST, ChunkResult, Sandbox
-from facelib.fdl.storyboard import ExpressionCue, GazeCue, SpeechSpec, Storyboard, VisemeCue
 from facelib.fdl.suggest import did_you_mean
 from facelib.fdl.thesis import SCRIPT_GLOBALS, check_fdl_table, sequence
 from facelib.fdl.values import LuaTable, to_python

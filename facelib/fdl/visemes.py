@@ -1,12 +1,12 @@
 """Viseme names a stored viseme script may use: those of ``facelib.visemes`` (one table,
-``facelib/data/visemes/visemes.csv``), checked with the script's file and line."""
+``facelib/data/mpeg4_visemes.csv``), checked with the script's file and line."""
 
 from __future__ import annotations
 
 from facelib.errors import FdlError, ParameterError
 from facelib.fdl.suggest import did_you_mean
-from facelib.visemes.tables import viseme_aliases
-from facelib.visemes.tables import viseme_id as _viseme_id
+from facelib.mpeg4.visemes import viseme_aliases
+from facelib.mpeg4.visemes import viseme_id as _viseme_id
 
 __all__ = ["check_viseme", "viseme_id"]
 

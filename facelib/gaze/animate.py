@@ -12,15 +12,15 @@ from typing import Any
 
 import numpy as np
 
+from facelib.checks import check_fps
+from facelib.cues import GazeCue
 from facelib.errors import ParameterError
-from facelib.fdl.storyboard import GazeCue
 from facelib.gaze.behaviours import BoundBehaviour, bind_behaviour, merge_behaviours
 from facelib.gaze.blinks import blink_closure, schedule_blinks
 from facelib.gaze.events import Blink, HeadMove, Saccade
 from facelib.gaze.model import gaze_model
 from facelib.gaze.motion import Motion
 from facelib.gaze.planner import Planner
-from facelib.mpeg4.stream import check_fps
 from facelib.mpeg4.tables import ANGLE_UNIT, N_FAPS
 from facelib.mpeg4.track import FapTrack
 

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from facelib.checks import check_fps
 from facelib.errors import ParameterError
 from facelib.mpeg4.tables import N_FAPS
 
@@ -18,16 +19,6 @@ VISEME_FIELDS = ("select1", "select2", "blend", "def")
 EXPRESSION_FIELDS = ("select1", "intensity1", "select2", "intensity2", "init_face", "def")
 """Columns of ``FapStream.expression`` (FAP 2): two expression ids 0-6 with intensities
 0-63, init_face and def flags."""
-
-
-def check_fps(fps: object) -> float:
-    """``fps`` as a float; ``ParameterError`` unless it is a finite number > 0."""
-    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.number)):
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
-    value = float(fps)
-    if not np.isfinite(value) or value <= 0:
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
-    return value
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:

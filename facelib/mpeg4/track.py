@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from facelib.checks import check_fps
 from facelib.errors import ParameterError
-from facelib.mpeg4.stream import check_fps
 from facelib.mpeg4.tables import N_FAPS
 
 __all__ = ["FapTrack"]

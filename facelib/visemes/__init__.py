@@ -1,15 +1,20 @@
-"""Speech to visemes: forced alignment (pocketsphinx, the ``speech`` extra), phone-to-viseme
-mapping (thesis annex B), coarticulation and viseme FAP curves, viseme scripts.
+"""Speech to visemes: phone-to-viseme mapping (thesis annex B), coarticulation and viseme
+FAP curves, viseme scripts.
 
-``animate(speech, fps=...)`` is the generator the animation pipeline calls; ``align`` is the
-forced aligner on its own. pocketsphinx is imported only when audio is aligned.
+``animate(speech, fps=...)`` is the generator the animation pipeline calls; ``align`` and
+``timeline_from_text`` are :mod:`facelib.speech`'s with the visemes of the phones added.
 """
 
-from facelib.visemes.align import SpeechWarning, align
-from facelib.visemes.animate import VisemeAnimation, animate, speech_timeline
+from facelib.errors import SpeechWarning
+from facelib.visemes.animate import (
+    VisemeAnimation,
+    align,
+    animate,
+    speech_timeline,
+    timeline_from_text,
+)
 from facelib.visemes.coarticulation import blend, driven_faps, envelope
-from facelib.visemes.durations import timeline_from_text
-from facelib.visemes.mapping import phones_to_visemes, visemes_for
+from facelib.visemes.mapping import phones_to_visemes, visemes_for, with_visemes
 from facelib.visemes.scripts import (
     timeline_from_json,
     timeline_to_json,
@@ -55,5 +60,6 @@ __all__ = [
     "viseme_targets",
     "visemes_for",
     "visemes_from_cues",
+    "with_visemes",
     "write_timeline",
 ]

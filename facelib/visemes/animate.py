@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from facelib.errors import ParameterError, SpeechError
-from facelib.fdl.storyboard import SpeechSpec
+from facelib.checks import check_fps
+from facelib.cues import SpeechSpec
+from facelib.errors import SpeechError
 from facelib.mpeg4.track import FapTrack
+from facelib.speech import align as align_phones
+from facelib.speech import timeline_from_text as phones_from_text
+from facelib.speech.align import OnImplausible
 from facelib.visemes.coarticulation import (
     blend,
     driven_faps,
@@ -17,10 +22,11 @@ from facelib.visemes.coarticulation import (
     frame_times_ms,
     speaking_mask,
 )
+from facelib.visemes.mapping import with_visemes
 from facelib.visemes.scripts import visemes_from_cues
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
-__all__ = ["VisemeAnimation", "animate", "speech_timeline"]
+__all__ = ["VisemeAnimation", "align", "animate", "speech_timeline", "timeline_from_text"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,6 +50,19 @@ class VisemeAnimation:
     speech: SpeechTimeline
 
 
+def align(audio: str | Path | np.ndarray, text: str | None = None, *,
+          sample_rate: int | None = None, on_implausible: OnImplausible = "warn",
+          ) -> SpeechTimeline:
+    """:func:`facelib.speech.align` (same arguments) with the visemes of its phones."""
+    return with_visemes(align_phones(audio, text, sample_rate=sample_rate,
+                                     on_implausible=on_implausible))
+
+
+def timeline_from_text(text: str, *, rate: float = 1.0) -> SpeechTimeline:
+    """:func:`facelib.speech.timeline_from_text` with the visemes of its phones."""
+    return with_visemes(phones_from_text(text, rate=rate))
+
+
 def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0) -> SpeechTimeline:
     """The timeline of ``speech`` in its own time (ms from ``speech.start_ms``): a stored
     viseme script as it is; audio and text by forced alignment; audio alone by phone-loop
@@ -54,8 +73,6 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0) -> SpeechTimeline:
         end = max(s.end_ms for s in shifted)
         return SpeechTimeline((), (), shifted, "script", end)
     if speech.audio is not None:
-        from facelib.visemes.align import align
-
         try:
             return align(speech.audio, speech.text)
         except SpeechError as exc:
@@ -64,8 +81,6 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0) -> SpeechTimeline:
             raise SpeechError(f"{exc.message} (speech of {speech.origin[0]}:"
                               f"{speech.origin[1]})", path=exc.path) from exc
     if speech.text:
-        from facelib.visemes.durations import timeline_from_text
-
         return timeline_from_text(speech.text, rate=rate)
     path, line = speech.origin if speech.origin else (None, None)
     raise SpeechError("speech has neither audio, text nor a viseme script", path=path, line=line)
@@ -79,8 +94,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0) -> VisemeAnima
     targets; weights are the speech envelope on the driven FAPs (0 elsewhere).
     ``rate`` is the speaking rate of the text-only duration model.
     """
-    if not (isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0):
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    fps = check_fps(fps)
     timeline = speech_timeline(speech, rate=rate).shifted(speech.start_ms)
     end_ms = speech.start_ms + timeline.duration_ms
     n_frames = math.floor(end_ms * fps / 1000) + 1

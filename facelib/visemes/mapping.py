@@ -9,9 +9,10 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from facelib.visemes.tables import phone_viseme, timing_rules, viseme_name
-from facelib.visemes.timeline import Span, VisemeSpan
+from facelib.visemes.timeline import PhoneTimeline, Span, SpeechTimeline, VisemeSpan
 
-__all__ = ["enforce_min_duration", "merge_short_silences", "phones_to_visemes", "visemes_for"]
+__all__ = ["enforce_min_duration", "merge_short_silences", "phones_to_visemes", "visemes_for",
+           "with_visemes"]
 
 _BILABIAL = 1
 
@@ -117,3 +118,9 @@ def _merge(out: list[VisemeSpan], i: int) -> None:
 def visemes_for(phones: Sequence[Span]) -> tuple[VisemeSpan, ...]:
     """The whole chain: map, merge short silences, enforce minimum durations."""
     return enforce_min_duration(merge_short_silences(phones_to_visemes(phones)))
+
+
+def with_visemes(timeline: PhoneTimeline) -> SpeechTimeline:
+    """``timeline`` (phones and words of :mod:`facelib.speech`) with its viseme spans."""
+    return SpeechTimeline(timeline.phones, timeline.words, visemes_for(timeline.phones),
+                          timeline.source, timeline.duration_ms)

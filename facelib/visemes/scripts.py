@@ -22,8 +22,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from facelib.cues import VisemeCue
 from facelib.errors import FdlError, ParameterError
-from facelib.fdl.storyboard import VisemeCue
 from facelib.visemes.tables import script_name, viseme_id, viseme_name
 from facelib.visemes.timeline import Span, SpeechTimeline, VisemeSpan
 
@@ -113,7 +113,7 @@ def timeline_to_sentence(timeline: SpeechTimeline, *, fps: float) -> str:
 
 def visemes_from_cues(cues: Sequence[VisemeCue]) -> tuple[VisemeSpan, ...]:
     """Viseme spans of a stored viseme script (``SpeechSpec.visemes``), names mapped by
-    ``visemes.csv``. An unknown name raises :class:`FdlError` at the cue's file and line."""
+    ``mpeg4_visemes.csv``. An unknown name raises :class:`FdlError` at the cue's file and line."""
     spans = []
     for cue in cues:
         try:

@@ -1,11 +1,8 @@
 """The viseme rules as data: loaders for the files in ``facelib/data/visemes/``.
 
-- ``visemes.csv``: the 15 MPEG-4 visemes and the names viseme scripts use for them.
 - ``phone_to_viseme.csv``: ARPAbet phone -> viseme (thesis annex B), diphthongs as two.
 - ``viseme_faps.json``: each viseme's FAP values (FAP units).
 - ``coarticulation.json``: dominance-function parameters and timing rules.
-- ``phone_durations.csv``: the text-only duration model.
-- ``letter_to_sound.csv``: pronunciations for words missing from the dictionary.
 
 Everything is read once, on first use, and returned as read-only data.
 """
@@ -26,6 +23,14 @@ import numpy as np
 
 from facelib.errors import FacelibError, ParameterError
 from facelib.mpeg4.tables import N_FAPS, fap
+from facelib.mpeg4.visemes import (
+    N_VISEMES,
+    script_name,
+    viseme_aliases,
+    viseme_id,
+    viseme_name,
+    viseme_names,
+)
 
 __all__ = [
     "N_VISEMES",
@@ -33,8 +38,6 @@ __all__ = [
     "PhoneViseme",
     "coarticulation_classes",
     "dominance_table",
-    "letter_to_sound_rules",
-    "phone_durations",
     "phone_viseme",
     "script_name",
     "timing_rules",
@@ -44,7 +47,6 @@ __all__ = [
     "viseme_targets",
 ]
 
-N_VISEMES = 15
 _DIR = "data/visemes"
 
 
@@ -88,67 +90,6 @@ def _data_error(name: str, line: int | None, message: str) -> FacelibError:
 
 
 @cache
-def _viseme_names() -> tuple[
-    tuple[str, ...], Mapping[str, int], Mapping[str, int], tuple[str, ...]
-]:
-    """(MPEG-4 names, exact alias -> id, unambiguous lower-case alias -> id, script names)."""
-    names: list[str] = []
-    script: list[str] = []
-    exact: dict[str, int] = {}
-    folded: dict[str, set[int]] = {}
-    for line, row in _csv_rows("visemes.csv"):
-        vid = int(row["id"])
-        if vid != len(names):
-            raise _data_error("visemes.csv", line, f"viseme ids must run 0-14, got {vid}")
-        names.append(row["name"])
-        script.append(row["thesis_names"].split()[0])
-        for alias in (row["name"], str(vid), *row["thesis_names"].split()):
-            exact.setdefault(alias, vid)
-            folded.setdefault(alias.lower(), set()).add(vid)
-    unique = {k: next(iter(v)) for k, v in folded.items() if len(v) == 1}
-    return tuple(names), MappingProxyType(exact), MappingProxyType(unique), tuple(script)
-
-
-def script_name(viseme: int) -> str:
-    """The name thesis ``Sentence`` scripts use for viseme id 0-14 (``"silence"``,
-    ``"pbm"``, ... ``"A"``, ``"U"``)."""
-    viseme_name(viseme)
-    return _viseme_names()[3][int(viseme)]
-
-
-def viseme_name(viseme: int) -> str:
-    """The MPEG-4 name (``"sil"``, ``"PP"``, ... ``"ou"``) of viseme id 0-14."""
-    names = _viseme_names()[0]
-    if not (isinstance(viseme, (int, np.integer)) and 0 <= viseme < N_VISEMES):
-        raise ParameterError(f"viseme id must be an integer 0-14, got {viseme!r}")
-    return names[int(viseme)]
-
-
-def viseme_aliases() -> Mapping[str, int]:
-    """Every name a script may give a viseme (MPEG-4 and thesis names) -> its id 0-14."""
-    return _viseme_names()[1]
-
-
-def viseme_id(name: str | int) -> int:
-    """The viseme id 0-14 of ``name``: an MPEG-4 name (``"aa"``), a thesis script name
-    (``"A"``, ``"kg"``, ``"silence"``), or the id itself. Case-sensitive first, then any
-    case where that is unambiguous (``"td"`` is 4 but ``"TD"`` is 3)."""
-    if isinstance(name, (int, np.integer)) and not isinstance(name, bool):
-        viseme_name(int(name))
-        return int(name)
-    _, exact, folded, _ = _viseme_names()
-    key = str(name).strip()
-    if key in exact:
-        return exact[key]
-    if key.lower() in folded:
-        return folded[key.lower()]
-    raise ParameterError(
-        f"unknown viseme {name!r}; use an MPEG-4 name ({', '.join(_viseme_names()[0])}) "
-        "or a thesis script name (silence, pbm, fv, TD, td, kg, tSdZS, sz, nl, r, A, e, I, Q, U)"
-    )
-
-
-@cache
 def _phone_table() -> Mapping[str, PhoneViseme]:
     table: dict[str, PhoneViseme] = {}
     for line, row in _csv_rows("phone_to_viseme.csv"):
@@ -181,7 +122,7 @@ def viseme_targets() -> np.ndarray:
     path, text = _text("viseme_faps.json")
     data = json.loads(text)
     targets = np.zeros((N_VISEMES, N_FAPS), np.float32)
-    names = _viseme_names()[0]
+    names = viseme_names()
     if set(data["visemes"]) != set(names):
         raise FacelibError(f"visemes {sorted(data['visemes'])} differ from {names}", path=path)
     for vid, name in enumerate(names):
@@ -222,7 +163,7 @@ def dominance_table() -> Mapping[tuple[int, str], Dominance]:
     data = _coarticulation()
     default = data["default"]
     out: dict[tuple[int, str], Dominance] = {}
-    for vid, name in enumerate(_viseme_names()[0]):
+    for vid, name in enumerate(viseme_names()):
         rules = data["visemes"].get(name, {})
         for cls in data["classes"]:
             params = {**default, **rules.get("*", {}), **rules.get(cls, {})}
@@ -244,21 +185,3 @@ def timing_rules() -> Mapping[str, int]:
     timing = _coarticulation()["timing"]
     return MappingProxyType({k: int(v) for k, v in timing.items() if not k.startswith("_")})
 
-
-@cache
-def phone_durations() -> Mapping[str, tuple[int, int]]:
-    """ARPAbet phone -> (mean_ms, min_ms) at speaking rate 1.0."""
-    return MappingProxyType(
-        {row["phone"]: (int(row["mean_ms"]), int(row["min_ms"])) for _, row in
-         _csv_rows("phone_durations.csv")}
-    )
-
-
-@cache
-def letter_to_sound_rules() -> tuple[tuple[str, tuple[str, ...]], ...]:
-    """(letter group, phones) rules, longest groups first (ties keep file order)."""
-    rules = [
-        (row["graphemes"], () if row["phones"] == "-" else tuple(row["phones"].split()))
-        for _, row in _csv_rows("letter_to_sound.csv")
-    ]
-    return tuple(sorted(rules, key=lambda r: -len(r[0])))

@@ -1,42 +1,14 @@
-"""Speech timelines: phone, word and viseme spans in integer milliseconds.
-
-A timeline is a chain of plain frozen records; each processing step (alignment, duration
-model, phone -> viseme mapping, minimum-duration rules) takes one and returns a new one.
-"""
+"""Speech timelines with visemes: the phone and word spans of :mod:`facelib.speech` plus the
+viseme spans made from them, in integer milliseconds."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Literal
 
 from facelib.errors import ParameterError
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Source, Span, check_interval
 
-__all__ = ["SILENCE", "Source", "Span", "SpeechTimeline", "VisemeSpan"]
-
-SILENCE = "SIL"
-"""The phone label of silence (and of the acoustic model's noise phones after cleaning)."""
-
-Source = Literal["forced", "phone-loop", "durations", "script"]
-
-
-@dataclass(frozen=True, slots=True)
-class Span:
-    """A labelled interval ``[start_ms, end_ms)``: a phone (ARPAbet without stress, silence
-    as ``"SIL"``) or a word (lower case, silence as ``"SIL"``)."""
-
-    label: str
-    start_ms: int
-    end_ms: int
-
-    def __post_init__(self) -> None:
-        _check_interval(self.label, self.start_ms, self.end_ms)
-
-    @property
-    def duration_ms(self) -> int:
-        return self.end_ms - self.start_ms
-
-    def shifted(self, offset_ms: int) -> Span:
-        return replace(self, start_ms=self.start_ms + offset_ms, end_ms=self.end_ms + offset_ms)
+__all__ = ["SILENCE", "PhoneTimeline", "Source", "Span", "SpeechTimeline", "VisemeSpan"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,7 +25,7 @@ class VisemeSpan:
     def __post_init__(self) -> None:
         if not 0 <= self.viseme <= 14:
             raise ParameterError(f"viseme id must be 0-14, got {self.viseme!r}")
-        _check_interval(self.name, self.start_ms, self.end_ms)
+        check_interval(self.name, self.start_ms, self.end_ms)
 
     @property
     def duration_ms(self) -> int:
@@ -97,12 +69,3 @@ class SpeechTimeline:
             self.source,
             self.duration_ms,
         )
-
-
-def _check_interval(label: str, start_ms: int, end_ms: int) -> None:
-    if not (isinstance(start_ms, int) and isinstance(end_ms, int)):
-        raise ParameterError(
-            f"span {label!r} times must be integer milliseconds, got {start_ms!r}, {end_ms!r}"
-        )
-    if end_ms < start_ms:
-        raise ParameterError(f"span {label!r} ends ({end_ms} ms) before it starts ({start_ms} ms)")

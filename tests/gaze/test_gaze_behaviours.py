@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from facelib.cues import GazeCue
 from facelib.errors import FdlError
-from facelib.fdl.storyboard import GazeCue
 from facelib.gaze import GAZE_FAPS, animate, bind_behaviour, simulate
 from facelib.gaze.behaviours import merge_behaviours
 from facelib.gaze.model import gaze_model

@@ -27,10 +27,10 @@ def _run(code: str, **env: str) -> subprocess.CompletedProcess:
 def test_no_platform_library_gives_install_hint():
     result = _run("""
         import numpy as np
-        from facelib.engine import render_backend
+        from facelib.rendering import platform as render_backend
         from facelib.errors import RenderError
         render_backend._loads = lambda name: False
-        from facelib.engine.render import render_still
+        from facelib.rendering.frames import render_still
         try:
             render_still(object(), np.zeros((3, 3)))
         except RenderError as exc:
@@ -44,7 +44,7 @@ def test_no_platform_library_gives_install_hint():
 
 def test_on_screen_platform_is_refused_for_offscreen():
     result = _run("""
-        from facelib.engine.render_backend import choose_platform
+        from facelib.rendering.platform import choose_platform
         from facelib.errors import RenderError
         try:
             choose_platform()
@@ -58,7 +58,7 @@ def test_missing_pyrender_names_the_extra():
     result = _run("""
         import sys
         sys.modules["pyrender"] = None  # as if pyrender2 were not installed
-        from facelib.engine.render_backend import import_pyrender
+        from facelib.rendering.platform import import_pyrender
         from facelib.errors import MissingExtraError
         try:
             import_pyrender()
@@ -73,7 +73,7 @@ def test_missing_pyrender_names_the_extra():
 def test_explicit_platform_is_respected(platform):
     result = _run("""
         import os
-        from facelib.engine.render_backend import import_pyrender, choose_platform
+        from facelib.rendering.platform import import_pyrender, choose_platform
         import_pyrender()
         import OpenGL.platform
         print(choose_platform(), type(OpenGL.platform.PLATFORM).__name__)
@@ -86,7 +86,7 @@ def test_explicit_platform_is_respected(platform):
 def test_import_facelib_render_modules_stays_light():
     result = _run("""
         import sys
-        import facelib, facelib.engine.render, facelib.engine.video
+        import facelib, facelib.rendering.frames, facelib.rendering.video
         heavy = [m for m in ("OpenGL", "pyrender", "pyglet", "tqdm", "imageio_ffmpeg")
                  if m in sys.modules]
         print("heavy:", heavy, "platform:", __import__("os").environ.get("PYOPENGL_PLATFORM"))
@@ -98,7 +98,7 @@ def test_import_facelib_render_modules_stays_light():
 def test_view_without_display_says_so():
     result = _run("""
         import os
-        from facelib.engine.viewer import view
+        from facelib.rendering.viewer import view
         from facelib.errors import RenderError
         from facelib.mpeg4.stream import FapStream
         try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facelib.engine.render_scene import FaceRenderer
+from facelib.rendering.scene import FaceRenderer
 
 engine = pytest.importorskip("facelib.engine")
 W, H = 200, 200

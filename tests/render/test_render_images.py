@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facelib.engine.render import render, render_still
-from facelib.engine.render_scene import FaceRenderer
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
+from facelib.rendering.frames import render, render_still
+from facelib.rendering.scene import FaceRenderer
 
 W, H = 160, 120
 

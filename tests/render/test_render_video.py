@@ -12,10 +12,10 @@ import pytest
 import soundfile
 from PIL import Image
 
-from facelib.engine.render import render
-from facelib.engine.video import encode_png, open_writer, probe_video, save_png
 from facelib.errors import ParameterError, RenderError
 from facelib.mpeg4.stream import FapStream
+from facelib.rendering.frames import render
+from facelib.rendering.video import encode_png, open_writer, probe_video, save_png
 
 W, H = 96, 72
 

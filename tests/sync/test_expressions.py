@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from facelib import FdlError, fap
+from facelib.cues import ExpressionCue
 from facelib.expressions import animate, default_library, envelope
-from facelib.fdl import ExpressionCue
 
 # Each expression moves these FAPs in this direction (+1 raises/closes/opens as the FAP's
 # positive direction says, -1 the other way).

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from facelib.cues import SpeechSpec, VisemeCue
 from facelib.errors import SpeechError
-from facelib.fdl.storyboard import SpeechSpec, VisemeCue
 from facelib.mpeg4.tables import fap
 from facelib.visemes import animate, driven_faps, viseme_targets
 

@@ -6,8 +6,8 @@ import json
 
 import pytest
 
+from facelib.cues import VisemeCue
 from facelib.errors import FdlError, ParameterError
-from facelib.fdl.storyboard import VisemeCue
 from facelib.visemes import (
     timeline_from_json,
     timeline_from_text,

@@ -1,5 +1,5 @@
 """Forced alignment of speech audio to its transcript, and phone-loop recognition, with
-pocketsphinx (the ``speech`` extra): audio -> phone and word timelines -> visemes.
+pocketsphinx (the ``speech`` extra): audio -> phone and word timelines.
 
 Two passes on 5 ms frames: the words are aligned first (``set_align_text``), then the phones
 inside them (``set_alignment``); inside each word, boundaries at transitions where the aligner
@@ -11,39 +11,25 @@ plausibility checks then warn or raise naming the word.
 
 from __future__ import annotations
 
-import json
 import warnings
 from collections.abc import Sequence
 from functools import cache
-from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
-from facelib.errors import FacelibWarning, ParameterError, SpeechError
-from facelib.visemes.audio import ALIGN_RATE, load_speech, to_pcm16
-from facelib.visemes.mapping import visemes_for
-from facelib.visemes.pronounce import model_dir, pronounce, tokenize
-from facelib.visemes.tables import phone_durations
-from facelib.visemes.timeline import SILENCE, Span, SpeechTimeline
+from facelib.errors import ParameterError, SpeechError, SpeechWarning
+from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
+from facelib.speech.pronounce import model_dir, pronounce, tokenize
+from facelib.speech.tables import alignment_settings, phone_durations
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 
-__all__ = ["SpeechWarning", "align", "alignment_settings"]
+__all__ = ["align"]
 
 OnImplausible = Literal["warn", "raise", "ignore"]
 _NOISE = {"SIL", "NSN", "SPN", "<sil>", "<s>", "</s>", "[NOISE]", "+NSN+", "+SPN+"}
 _PHONE_LOOP = "_facelib_phone_loop"
-
-
-class SpeechWarning(FacelibWarning):
-    """An alignment succeeded but looks implausible (named word, reason)."""
-
-
-@cache
-def alignment_settings() -> dict[str, Any]:
-    """The settings of ``facelib/data/visemes/alignment.json`` (keys without ``_about``)."""
-    text = resources.files("facelib").joinpath("data/visemes/alignment.json").read_text("utf-8")
-    return {k: v for k, v in json.loads(text).items() if not k.startswith("_")}
 
 
 @cache
@@ -70,8 +56,8 @@ def align(
     *,
     sample_rate: int | None = None,
     on_implausible: OnImplausible = "warn",
-) -> SpeechTimeline:
-    """Phones, words and visemes of speech ``audio``.
+) -> PhoneTimeline:
+    """Phones and words of speech ``audio``.
 
     Parameters
     ----------
@@ -89,7 +75,7 @@ def align(
 
     Returns
     -------
-    SpeechTimeline with times in ms from the start of the audio.
+    PhoneTimeline with times in ms from the start of the audio.
 
     Raises
     ------
@@ -107,14 +93,14 @@ def align(
     where = audio if not isinstance(audio, np.ndarray) else None
     if text is None:
         phones = _phone_loop(pcm, duration_ms)
-        return SpeechTimeline(phones, (), visemes_for(phones), "phone-loop", duration_ms)
+        return PhoneTimeline(phones, (), "phone-loop", duration_ms)
     phones, words, problems = _forced(pcm, text, duration_ms, where)
     if problems and on_implausible != "ignore":
         message = "implausible alignment: " + "; ".join(problems)
         if on_implausible == "raise":
             raise SpeechError(message, path=where)
         warnings.warn(message, SpeechWarning, stacklevel=2)
-    return SpeechTimeline(phones, words, visemes_for(phones), "forced", duration_ms)
+    return PhoneTimeline(phones, words, "forced", duration_ms)
 
 
 def _decode(decoder: Any, pcm: bytes) -> None:

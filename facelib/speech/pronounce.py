@@ -10,7 +10,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from facelib.errors import MissingExtraError, SpeechError
-from facelib.visemes.tables import letter_to_sound_rules
+from facelib.speech.tables import letter_to_sound_rules
 
 __all__ = ["dictionary", "letter_to_sound", "pronounce", "tokenize"]
 

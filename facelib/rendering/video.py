@@ -19,8 +19,8 @@ from typing import Protocol
 
 import numpy as np
 
+from facelib.checks import check_fps
 from facelib.errors import MissingExtraError, ParameterError, RenderError
-from facelib.mpeg4.stream import check_fps
 
 __all__ = [
     "FrameWriter",

@@ -24,8 +24,9 @@ from typing import Any, Literal
 import numpy as np
 import scipy.sparse as sp
 
-from facelib.engine.render_backend import INSTALL_HINT, import_pyrender
 from facelib.errors import FaceModelError, ParameterError, RenderError
+from facelib.rendering.platform import INSTALL_HINT, import_pyrender
+from facelib.rendering.protocols import Deformable
 
 __all__ = ["FaceRenderer", "Look", "PartMesh", "frame_camera", "load_look", "split_parts",
            "vertex_normals"]
@@ -218,7 +219,7 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
-def _face_arrays(face: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _face_arrays(face: Deformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     try:
         vertices = np.asarray(face.vertices, np.float32)
         triangles = np.asarray(face.triangles, np.int64)
@@ -295,7 +296,7 @@ class FaceRenderer:
 
     def __init__(
         self,
-        face: Any,
+        face: Deformable,
         *,
         width: int = 640,
         height: int = 480,

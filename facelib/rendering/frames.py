@@ -3,7 +3,7 @@
 ``render`` plays a :class:`~facelib.mpeg4.stream.FapStream` (or an animation object that
 carries one as ``.faps``, with an optional ``.audio`` path) on a face and returns or writes
 the frames; ``render_still`` renders one pose. OpenGL and pyrender load on first use, on
-the headless platform chosen by :mod:`facelib.engine.render_backend`.
+the headless platform chosen by :mod:`facelib.rendering.platform`.
 """
 
 from __future__ import annotations
@@ -12,22 +12,22 @@ import os
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from facelib.engine.render_scene import FaceRenderer
-from facelib.engine.video import open_writer, save_png
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS
+from facelib.rendering.protocols import Deformable, HasFaps
+from facelib.rendering.scene import FaceRenderer
+from facelib.rendering.video import open_writer, save_png
 
-__all__ = ["iter_frames", "render", "render_still", "save_png", "stream_of"]
+__all__ = ["face_or_default", "iter_frames", "render", "render_still", "save_png", "stream_of"]
 
 _CHUNK = 32  # frames deformed at once: bounds memory to 32 x V x 3 floats
 
 
-def stream_of(source: Any) -> tuple[FapStream, Path | None, float]:
+def stream_of(source: FapStream | HasFaps) -> tuple[FapStream, Path | None, float]:
     """``(stream, audio path or None, audio offset in seconds)`` of a render source.
 
     ``source`` is a :class:`FapStream` or an object with a ``faps`` FapStream and optional
@@ -47,16 +47,17 @@ def stream_of(source: Any) -> tuple[FapStream, Path | None, float]:
     )
 
 
-def _default_face(face: Any) -> Any:
+def face_or_default(face: Deformable | None) -> Deformable:
+    """``face``, or facelib's default head when it is None."""
     if face is not None:
         return face
-    from facelib.engine import load_face
+    from facelib.engine import default_face
 
-    return load_face(None)
+    return default_face()
 
 
 def iter_frames(
-    renderer: FaceRenderer, face: Any, stream: FapStream, *, progress: bool = False
+    renderer: FaceRenderer, face: Deformable, stream: FapStream, *, progress: bool = False
 ) -> Iterator[np.ndarray]:
     """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``."""
     bar = None
@@ -80,9 +81,9 @@ def iter_frames(
 
 
 def render(
-    source: Any,
+    source: FapStream | HasFaps,
     *,
-    face: Any = None,
+    face: Deformable | None = None,
     out: str | os.PathLike[str] | None = None,
     width: int = 640,
     height: int = 480,
@@ -120,7 +121,7 @@ def render(
         stream = stream.resample(fps)
     audio = source_audio if audio is None else Path(audio)
     offset = source_offset if audio_offset is None else float(audio_offset)
-    face = _default_face(face)
+    face = face_or_default(face)
     if out is not None and Path(out).suffix.lower() == ".png":
         if stream.n_frames != 1:
             raise ParameterError(
@@ -153,7 +154,7 @@ def render(
 
 
 def render_still(
-    face: Any,
+    face: Deformable,
     pose: np.ndarray | None = None,
     *,
     width: int = 640,
@@ -164,9 +165,9 @@ def render_still(
 
     ``pose`` is an ``(84,)`` FAP vector (deformed with ``face.deform_frame``), a ``(V, 3)``
     vertex array, or None for the neutral face. For many stills of one face, keep a
-    :class:`~facelib.engine.render_scene.FaceRenderer` open instead (one OpenGL context).
+    :class:`~facelib.rendering.scene.FaceRenderer` open instead (one OpenGL context).
     """
-    face = _default_face(face)
+    face = face_or_default(face)
     if pose is None:
         vertices = np.asarray(face.vertices, np.float32)
     else:

@@ -10,14 +10,15 @@ from __future__ import annotations
 import os
 import sys
 import time
-from typing import Any
 
 import numpy as np
 
-from facelib.engine.render import _default_face, stream_of
-from facelib.engine.render_backend import import_pyrender
-from facelib.engine.render_scene import FaceRenderer
 from facelib.errors import RenderError
+from facelib.mpeg4.stream import FapStream
+from facelib.rendering.frames import face_or_default, stream_of
+from facelib.rendering.platform import import_pyrender
+from facelib.rendering.protocols import Deformable, HasFaps
+from facelib.rendering.scene import FaceRenderer
 
 __all__ = ["has_display", "view"]
 
@@ -30,9 +31,9 @@ def has_display() -> bool:
 
 
 def view(
-    source: Any,
+    source: FapStream | HasFaps,
     *,
-    face: Any = None,
+    face: Deformable | None = None,
     width: int = 800,
     height: int = 600,
     loop: bool = False,
@@ -58,7 +59,7 @@ def view(
             f"{os.environ['PYOPENGL_PLATFORM']!r}); open the viewer in a fresh process"
         )
     stream, _, _ = stream_of(source)
-    face = _default_face(face)
+    face = face_or_default(face)
     pr = import_pyrender(offscreen=False)
     scene = FaceRenderer(face, width=width, height=height, mesh_update="swap", offscreen=False)
     try:

@@ -3,17 +3,11 @@ while a writer drafts a storyboard before the voice is recorded."""
 
 from __future__ import annotations
 
-import csv
-import io
-from collections.abc import Mapping
-from functools import cache
-from importlib import resources
-
 from facelib.errors import MissingExtraError, ParameterError, SpeechError
-from facelib.visemes.mapping import visemes_for
-from facelib.visemes.pronounce import letter_to_sound, pronounce, tokenize
-from facelib.visemes.tables import phone_durations
-from facelib.visemes.timeline import SILENCE, Span, SpeechTimeline
+from facelib.speech.pronounce import letter_to_sound, pronounce, tokenize
+from facelib.speech.tables import pauses as pause_table
+from facelib.speech.tables import phone_durations
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 
 __all__ = ["FINAL_LENGTHENING", "SHORT_WORD_VOWEL", "timeline_from_text"]
 
@@ -26,14 +20,6 @@ _VOWELS = frozenset(
 )
 
 
-@cache
-def _pauses() -> Mapping[str, int]:
-    text = resources.files("facelib").joinpath("data/visemes/pauses.csv").read_text("utf-8")
-    rows = csv.DictReader(io.StringIO("\n".join(
-        line for line in text.splitlines() if line and not line.startswith("#"))))
-    return {row["mark"]: int(row["pause_ms"]) for row in rows}
-
-
 def _phones_of(word: str) -> tuple[str, ...]:
     try:
         return pronounce(word)[0]
@@ -41,13 +27,13 @@ def _phones_of(word: str) -> tuple[str, ...]:
         return letter_to_sound(word)
 
 
-def timeline_from_text(text: str, *, rate: float = 1.0) -> SpeechTimeline:
-    """Phones, words and visemes of ``text`` spoken at ``rate`` (1.0 is about 160 words per
+def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
+    """Phones and words of ``text`` spoken at ``rate`` (1.0 is about 160 words per
     minute; 2.0 twice as fast), from the duration model (``phone_durations.csv``, pauses at
     punctuation from ``pauses.csv``). Times in ms from 0; ``source="durations"``."""
     if not (isinstance(rate, (int, float)) and 0.25 <= rate <= 4):
         raise ParameterError(f"speaking rate must be between 0.25 and 4, got {rate!r}")
-    pauses = _pauses()
+    pauses = pause_table()
     table = phone_durations()
     tokens = tokenize(text)
     phones: list[Span] = []
@@ -82,7 +68,7 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> SpeechTimeline:
             t += ms
     phones = _join_silences(phones)
     words = _join_silences(words)
-    return SpeechTimeline(tuple(phones), tuple(words), visemes_for(phones), "durations", t)
+    return PhoneTimeline(tuple(phones), tuple(words), "durations", t)
 
 
 def _join_silences(spans: list[Span]) -> list[Span]:

@@ -1,0 +1,57 @@
+"""The speech rules as data: loaders for the files in ``facelib/data/speech/``.
+
+- ``alignment.json``: forced-alignment settings (frame rate, beams, boundary shifts, checks).
+- ``phone_durations.csv``: the text-only duration model.
+- ``pauses.csv``: pauses at punctuation for the duration model.
+- ``letter_to_sound.csv``: pronunciations for words missing from the dictionary.
+
+Each is read once, on first use, and returned read-only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from functools import cache
+from types import MappingProxyType
+from typing import Any
+
+from facelib import data
+
+__all__ = ["alignment_settings", "letter_to_sound_rules", "pauses", "phone_durations"]
+
+
+@cache
+def _alignment() -> Mapping[str, Any]:
+    return MappingProxyType(data.json_data("speech/alignment.json"))
+
+
+def alignment_settings() -> Mapping[str, Any]:
+    """The settings of ``alignment.json`` (keys without ``_about``)."""
+    return _alignment()
+
+
+@cache
+def phone_durations() -> Mapping[str, tuple[int, int]]:
+    """ARPAbet phone -> (mean_ms, min_ms) at speaking rate 1.0."""
+    return MappingProxyType(
+        {row["phone"]: (int(row["mean_ms"]), int(row["min_ms"]))
+         for _, row in data.csv_rows("speech/phone_durations.csv")}
+    )
+
+
+@cache
+def pauses() -> Mapping[str, int]:
+    """Punctuation mark (or ``"edge"``) -> pause in ms at speaking rate 1.0."""
+    return MappingProxyType(
+        {row["mark"]: int(row["pause_ms"]) for _, row in data.csv_rows("speech/pauses.csv")}
+    )
+
+
+@cache
+def letter_to_sound_rules() -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """(letter group, phones) rules, longest groups first (ties keep file order)."""
+    rules = [
+        (row["graphemes"], () if row["phones"] == "-" else tuple(row["phones"].split()))
+        for _, row in data.csv_rows("speech/letter_to_sound.csv")
+    ]
+    return tuple(sorted(rules, key=lambda r: -len(r[0])))
