@@ -31,6 +31,7 @@ log = logging.getLogger("facelib.fdl")
 DEFAULT_FPS = 25.0
 SETTINGS = ("fps", "seed", "output", "FDL", "expressions", "eyes", "Sentence")
 """Globals a storyboard may set (besides its own helpers and variables)."""
+_MIN_FPS = 1.0
 _MAX_FPS = 1000.0
 
 
@@ -158,10 +159,10 @@ def _build(
     if (
         isinstance(fps, bool)
         or not isinstance(fps, int | float)
-        or not (math.isfinite(fps) and 0 < fps <= _MAX_FPS)
+        or not (math.isfinite(fps) and _MIN_FPS <= fps <= _MAX_FPS)
     ):
         raise FdlError(
-            f"fps must be a number above 0 and at most {_MAX_FPS:g}; got {fps!r}",
+            f"fps must be a number from {_MIN_FPS:g} to {_MAX_FPS:g}; got {fps!r}",
             path=name,
             line=fps_line,
         )
