@@ -226,6 +226,8 @@ def _build(
             base_dir, output_value, what="output", path=name, line=output_line, must_exist=False
         )
     )
+    if output is not None:
+        _check_output(output, inputs=(file, *_inputs_of(speech)), path=name, line=output_line)
     return Storyboard(
         path=file,
         fps=float(fps),
@@ -238,6 +240,30 @@ def _build(
         output=output,
         expression_mixes=parts.expression_mixes,
     )
+
+
+OUTPUT_SUFFIXES = (".fap", ".mp4", ".gif")
+"""What a storyboard's ``output`` may name: the files facelib writes."""
+
+
+def _inputs_of(speech: SpeechSpec | None) -> tuple[Path, ...]:
+    if speech is None or speech.audio is None:
+        return ()
+    return (Path(speech.audio),)
+
+
+def _check_output(output: Path, *, inputs: tuple[Path | None, ...], path: str,
+                  line: int | None) -> None:
+    """A storyboard may only name an output facelib writes: a known suffix, not a hidden
+    file, not the storyboard itself or a file it reads."""
+    if output.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise FdlError(f"output {output.name!r} must end in one of {', '.join(OUTPUT_SUFFIXES)}",
+                       path=path, line=line)
+    if output.name.startswith("."):
+        raise FdlError(f"output {output.name!r} must not be a hidden file", path=path, line=line)
+    if any(source is not None and output == source.resolve() for source in inputs):
+        raise FdlError(f"output {output.name!r} would overwrite one of the storyboard's inputs",
+                       path=path, line=line)
 
 
 def _sub_script(
