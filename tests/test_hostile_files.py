@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -64,9 +65,9 @@ def test_outputs_never_replace_special_files(tmp_path, kind):
         target.mkdir()
     else:
         target = ""
-    with pytest.raises(ParameterError, match="will not replace|empty"):
+    with pytest.raises(ParameterError, match=r"will not replace|empty"):
         write_fap(stream, target)
-    assert os.path.exists("/dev/null") and not os.path.isfile("/dev/null")
+    assert Path("/dev/null").exists() and not Path("/dev/null").is_file()
     if kind == "symlink":
         assert (tmp_path / "link.fap").is_symlink()
         assert (tmp_path / "real.fap").read_text() == "keep"
@@ -84,9 +85,13 @@ def test_unwritable_folder_is_a_parameter_error(tmp_path):
 
 
 def test_interrupted_write_leaves_no_temporary(tmp_path):
-    with pytest.raises(KeyboardInterrupt), atomic_path(tmp_path / "out.mp4") as temp:
-        temp.write_bytes(b"partial")
-        raise KeyboardInterrupt
+    def interrupted() -> None:
+        with atomic_path(tmp_path / "out.mp4") as temp:
+            temp.write_bytes(b"partial")
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        interrupted()
     assert list(tmp_path.iterdir()) == []
 
 
