@@ -45,6 +45,10 @@ _WRITE_DIALECTS = ("standard", "xface", "greta", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
 _GROUP = {0: len(VISEME_FIELDS), 1: len(EXPRESSION_FIELDS)}
 
+# One parsed frame: (frame number, values (84,) float32, mask (84,) bool,
+# viseme (4,) int16 or None, expression (6,) int16 or None).
+_Frame = tuple[int, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]
+
 
 @dataclass(frozen=True)
 class FapFile:
@@ -144,7 +148,7 @@ class _Parser:
                 raise self.error(body[1], "frame numbers must start at 0 in strict mode")
             if dialect == "standard":
                 dialect = "vreng"
-            frames = [(number - 1, *rest) for number, *rest in frames]
+            frames = [(f[0] - 1, *f[1:]) for f in frames]
         if self.float_values and dialect == "standard":
             dialect = "xface"
         return self.assemble(frames, body, fps=fps, n_frames=n_frames, name=name, version=version,
@@ -182,7 +186,7 @@ class _Parser:
 
     def frame(
         self, mask_line: _Line, value_line: _Line, width: int, dialect: str
-    ) -> tuple[int, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    ) -> _Frame:
         if len(mask_line.tokens) != width:
             raise self.error(mask_line, f"mask line has {len(mask_line.tokens)} tokens, "
                              f"expected {width} like the first mask line")
@@ -203,7 +207,7 @@ class _Parser:
         mask = np.zeros(N_FAPS, bool)
         viseme = expression = None
         position = 0
-        for slot in np.flatnonzero(flags):
+        for slot in (int(s) for s in np.flatnonzero(flags)):
             if slot in groups:
                 count = groups[slot]
                 field = [self.number(value_line, t, integer=True) for t in
@@ -251,7 +255,7 @@ class _Parser:
         return value
 
     def assemble(
-        self, frames: list, body: list[_Line], *, fps: float, n_frames: int, name: str,
+        self, frames: list[_Frame], body: list[_Line], *, fps: float, n_frames: int, name: str,
         version: str, dialect: str,
     ) -> FapFile:
         values = np.zeros((n_frames, N_FAPS), np.float32)
