@@ -137,7 +137,7 @@ class Storyboard:
     def cues_end_ms(self) -> int:
         """End of the last expression, gaze or stored-viseme cue (speech audio may last
         longer; the animation pipeline takes the longest track)."""
-        ends = [c.end_ms for c in (*self.expressions, *self.gaze)]
+        ends = [c.end_ms for c in self.expressions] + [c.end_ms for c in self.gaze]
         if self.speech is not None and self.speech.visemes:
             ends += [c.end_ms for c in self.speech.visemes]
         return max(ends, default=0)

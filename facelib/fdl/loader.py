@@ -13,13 +13,13 @@ import math
 from pathlib import Path
 from typing import Any
 
+from facelib.checks import did_you_mean
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard, VisemeCue
 from facelib.errors import FdlError
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.modern import FUNCTIONS, DraftCue, DraftSpeech, ModernParts, read_calls
 from facelib.fdl.paths import read_text, resolve_inside
 from facelib.fdl.sandbox import WHITELIST, ChunkResult, Sandbox
-from facelib.fdl.suggest import did_you_mean
 from facelib.fdl.thesis import SCRIPT_GLOBALS, check_fdl_table, sequence
 from facelib.fdl.values import LuaTable, to_python
 from facelib.fdl.visemes import check_viseme
@@ -179,7 +179,8 @@ def _build(
             lists[list_name] = (value, ctx)
     if fdl is not None:
         for field_name, list_name in SCRIPT_GLOBALS.items():
-            if fdl.get(field_name) is None:
+            script = fdl.get(field_name)
+            if script is None:
                 continue
             where = ctx.line_of(field_name, after=fdl_line)
             if list_name in lists:
@@ -189,7 +190,7 @@ def _build(
                     line=where,
                 )
             lists[list_name] = _sub_script(
-                fdl[field_name], list_name, ctx, where, seed=seed, box=box
+                script, list_name, ctx, where, seed=seed, box=box
             )
 
     calls = []

@@ -29,12 +29,12 @@ from __future__ import annotations
 import re
 import time
 from dataclasses import dataclass
-from importlib import resources
 from typing import Any
 
+from facelib import data
+from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.marking import mark_tables
-from facelib.fdl.suggest import did_you_mean
 
 __all__ = [
     "DEFAULT_MAX_INSTRUCTIONS",
@@ -129,7 +129,7 @@ class Sandbox:
             attribute_filter=_refuse_attribute,
             max_memory=self.max_memory,
         )
-        boot = resources.files("facelib.data").joinpath("fdl/sandbox.lua").read_text("utf-8")
+        boot = data.text("fdl/sandbox.lua")
         # The bootstrap needs the standard library, so it runs without the memory cap.
         self._run, self._collect = self._lua.execute(
             boot, self._print, time.monotonic, name="=fdl-sandbox", mode="t"

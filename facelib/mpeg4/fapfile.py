@@ -68,6 +68,10 @@ held): a bound on what a header can make the reader allocate."""
 _INTEGER = re.compile(r"[0-9]+")
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
+# One parsed frame: (frame number, values (84,) float32, mask (84,) bool,
+# viseme (4,) int16 or None, expression (6,) int16 or None).
+_Frame = tuple[int, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]
+
 
 @dataclass(frozen=True)
 class FapFile:
@@ -162,7 +166,7 @@ class _Parser:
         if n_frames > most:
             raise self.error(first, f"the header declares {n_frames} frames, but a file of "
                              f"{self.size} bytes cannot describe more than {most}")
-        frames: list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]]
+        frames: list[_Frame]
         frames, value_lines, width, dialect = [], [], 0, "standard"
         for mask_line in body:
             value_line = next(body, None)
@@ -187,7 +191,7 @@ class _Parser:
                 raise self.error(value_lines[0], "frame numbers must start at 0 in strict mode")
             if dialect == "standard":
                 dialect = "vreng"
-            frames = [(number - 1, *rest) for number, *rest in frames]
+            frames = [(f[0] - 1, *f[1:]) for f in frames]
         if self.float_values and dialect == "standard":
             dialect = "xface"
         return self.assemble(frames, value_lines, fps=fps, n_frames=n_frames, name=name,
@@ -225,7 +229,7 @@ class _Parser:
 
     def frame(
         self, mask_line: _Line, value_line: _Line, width: int, dialect: str
-    ) -> tuple[int, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    ) -> _Frame:
         if len(mask_line.tokens) != width:
             raise self.error(mask_line, f"mask line has {len(mask_line.tokens)} tokens, "
                              f"expected {width} like the first mask line")
@@ -246,7 +250,7 @@ class _Parser:
         mask = np.zeros(N_FAPS, bool)
         viseme = expression = None
         position = 0
-        for slot in np.flatnonzero(flags):
+        for slot in (int(s) for s in np.flatnonzero(flags)):
             if slot in groups:
                 count = groups[slot]
                 field = [self.number(value_line, t, integer=True) for t in
@@ -302,7 +306,8 @@ class _Parser:
         return value
 
     def assemble(
-        self, frames: list, value_lines: list[_Line], *, fps: float, n_frames: int, name: str,
+        self, frames: list[_Frame], value_lines: list[_Line], *, fps: float, n_frames: int,
+        name: str,
         version: str, dialect: str,
     ) -> FapFile:
         values = np.zeros((n_frames, N_FAPS), np.float32)

@@ -56,7 +56,7 @@ class FapStream:
 
     fps: float
     values: np.ndarray
-    mask: np.ndarray = field(default=None)  # type: ignore[assignment]
+    mask: np.ndarray = field(default=None)  # type: ignore[arg-type]  # None: filled in
     viseme: np.ndarray | None = None
     expression: np.ndarray | None = None
 

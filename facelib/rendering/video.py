@@ -170,6 +170,7 @@ class _FfmpegWriter:
                 f"frame {self.n_frames} is {frame.shape[1]}x{frame.shape[0]}, the video is "
                 f"{self._size[0]}x{self._size[1]}"
             )
+        assert self._proc.stdin is not None  # opened with stdin=PIPE
         try:
             self._proc.stdin.write(np.ascontiguousarray(frame).tobytes())
         except BrokenPipeError:
@@ -180,6 +181,7 @@ class _FfmpegWriter:
         self.n_frames += 1
 
     def commit(self) -> Path:
+        assert self._proc.stdin is not None  # opened with stdin=PIPE
         self._proc.stdin.close()
         if self._proc.wait() != 0:
             error = self._error("while encoding")
