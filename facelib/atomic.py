@@ -37,7 +37,7 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     except FileNotFoundError:
         info = None
     except OSError as exc:
-        raise ParameterError(f"cannot write {str(target)!r}: {exc.strerror}") from None
+        raise ParameterError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
     if info is not None and not stat.S_ISREG(info.st_mode):
         kind = ("a folder" if stat.S_ISDIR(info.st_mode) else "a symbolic link"
                 if stat.S_ISLNK(info.st_mode) else "a device or pipe")
@@ -81,7 +81,7 @@ def temp_beside(path: str | os.PathLike[str], *, suffix: str | None = None) -> P
         handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.{os.getpid()}.",
                                         suffix=path.suffix if suffix is None else suffix)
     except OSError as exc:
-        raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+        raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
     os.close(handle)
     return Path(name)
 
@@ -123,4 +123,4 @@ def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
         try:
             temp.write_text(text, encoding="utf-8", newline="\n")
         except OSError as exc:
-            raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+            raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None

@@ -148,7 +148,7 @@ def test_failed_write_leaves_the_old_file(tmp_path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr(Path, "write_text", boom)
-    with pytest.raises(OSError, match="disk full"):
+    with pytest.raises(ParameterError, match="disk full"):
         write_fap(FapStream(25, np.zeros((2, 84))), path)
     monkeypatch.undo()
     assert path.read_text() == "old"
