@@ -107,7 +107,7 @@ class Evaluation:
 
 
 def _lip_ids(face: Face, group: str) -> np.ndarray:
-    ids = [r.vertices for r in face.regions if r.group == group or r.name == group]
+    ids = [r.vertices for r in face.regions if group in (r.group, r.name)]
     if not ids:
         raise ParameterError(f"the face has no region or group {group!r}")
     return np.unique(np.concatenate(ids))
@@ -195,8 +195,8 @@ def _markdown(ev: Evaluation) -> str:
     table = summary_table(ev)
     ranked = sorted(table, key=lambda r: r["syllables_mean"])
     lines = [
-        "| rank | deformer | visemes mean | visemes var | expressions mean | syllables mean "
-        "| syllables var | worst viseme / rbf | max flipped | linearised vs exact (mm) |",
+        ("| rank | deformer | visemes mean | visemes var | expressions mean | syllables mean "
+         "| syllables var | worst viseme / rbf | max flipped | linearised vs exact (mm) |"),
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for i, r in enumerate(ranked, 1):

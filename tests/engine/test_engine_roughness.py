@@ -75,9 +75,7 @@ def test_r6_report_format(face: Face) -> None:
 
 
 def test_neighbourhood_rings() -> None:
-    # a fan of 6 triangles around vertex 0 and one more triangle outside it
-    ring = np.array([[np.cos(a), np.sin(a), 0.0] for a in np.linspace(0, 2 * np.pi, 7)[:-1]])
-    verts = np.vstack([[0.0, 0, 0], ring, [3.0, 0.0, 0.0]])
+    # a fan of 6 triangles around vertex 0 (ring 1-6) and one more triangle outside it
     tris = np.array([[0, i, i % 6 + 1] for i in range(1, 7)] + [[1, 7, 2]])
     one, two = neighbourhoods(tris, np.array([0]), 8, rings=1)[0], \
         neighbourhoods(tris, np.array([0]), 8, rings=2)[0]
