@@ -118,3 +118,10 @@ def test_text_only_speech_length_is_bounded() -> None:
     with pytest.raises(SpeechError, match="more than 100000") as info:
         facelib.animate(board)
     assert info.value.line == 1
+
+
+def test_deep_nesting_has_a_clear_message() -> None:
+    fdl.loads("x = " + "{" * 80 + "}" * 80)
+    with pytest.raises(FdlError, match="nested too deeply") as info:
+        fdl.loads("\nx = " + "{" * 150 + "}" * 150, name="story.fdl")
+    assert info.value.line == 2
