@@ -13,6 +13,8 @@ from facelib import fdl
 from facelib.errors import FdlError, ParameterError, SpeechError
 from facelib.fdl.sandbox import Sandbox
 
+pytestmark = pytest.mark.usefixtures("memory_cap")
+
 C_WORK = {
     "rep_in_a_loop": 'while true do local s = string.rep("x", 4 * 1024 * 1024) end',
     "gsub_of_10_mb": 'local s = string.rep("a", 10 * 1024 * 1024) while true do '
