@@ -8,11 +8,14 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import facelib
 from facelib.errors import FacelibError
 from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
+
+if TYPE_CHECKING:
+    from facelib.animation import Animation
 
 __all__ = ["main"]
 
@@ -50,7 +53,7 @@ def _check(args: argparse.Namespace) -> int:
     return 0
 
 
-def _animation(path: str, seed: int | None) -> Any:
+def _animation(path: str, seed: int | None) -> Animation | FapStream:
     """A storyboard's Animation, or a .fap file's stream."""
     if Path(path).suffix.lower() == ".fap":
         return read_fap(path)

@@ -16,6 +16,7 @@ __all__ = [
     "FacelibWarning",
     "FapFormatError",
     "FdlError",
+    "FdlWarning",
     "MissingExtraError",
     "ParameterError",
     "RenderError",
@@ -90,6 +91,11 @@ class MissingExtraError(FacelibError, ImportError):
 
 class FacelibWarning(UserWarning):
     """Something was accepted but looked irregular (e.g. frames missing from a ``.fap``)."""
+
+
+class FdlWarning(FacelibWarning):
+    """A storyboard ran but something in it looks like a mistake (a global that is no
+    setting but close to one, ``fsp = 30``), named with its file and line."""
 
 
 class SpeechWarning(FacelibWarning):

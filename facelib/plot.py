@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +15,12 @@ from facelib.atomic import atomic_path
 from facelib.errors import MissingExtraError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from facelib.animation import Animation
+    from facelib.cues import Storyboard
 
 __all__ = ["REGIONS", "plot_curves"]
 
@@ -33,7 +39,7 @@ REGIONS: tuple[tuple[str, tuple[int, ...]], ...] = (
 
 
 def plot_curves(
-    source: FapStream | Any,
+    source: FapStream | Animation,
     out: str | os.PathLike[str],
     *,
     title: str | None = None,
@@ -82,16 +88,14 @@ def plot_curves(
     return Path(out)
 
 
-def _shade_cues(ax: Any, storyboard: Any) -> None:
-    colours = {"expression": "tab:orange", "gaze": "tab:blue"}
-    for kind, cues in (("expression", storyboard.expressions), ("gaze", storyboard.gaze)):
-        for cue in cues:
-            start, end = cue.start_ms / 1000, cue.end_ms / 1000
-            ax.axvspan(start, end, color=colours[kind], alpha=0.07, lw=0)
-            label = cue.name if kind == "expression" else cue.behaviour
-            y = 0.95 if kind == "expression" else 0.05
-            ax.text(start, y, label, transform=ax.get_xaxis_transform(), fontsize=6,
-                    color=colours[kind], va="top" if y > 0.5 else "bottom")
+def _shade_cues(ax: Axes, storyboard: Storyboard) -> None:
+    labelled = [("tab:orange", 0.95, c.start_ms, c.end_ms, c.name) for c in storyboard.expressions]
+    labelled += [("tab:blue", 0.05, c.start_ms, c.end_ms, c.behaviour) for c in storyboard.gaze]
+    for colour, y, start_ms, end_ms, label in labelled:
+        start, end = start_ms / 1000, end_ms / 1000
+        ax.axvspan(start, end, color=colour, alpha=0.07, lw=0)
+        ax.text(start, y, label, transform=ax.get_xaxis_transform(), fontsize=6,
+                color=colour, va="top" if y > 0.5 else "bottom")
     speech = storyboard.speech
     if speech is not None and speech.visemes:
         ax.axvspan(speech.visemes[0].start_ms / 1000, speech.visemes[-1].end_ms / 1000,

@@ -93,13 +93,13 @@ class _Reader:
         vertices, triangles, colours = self.mesh()
         nv = len(vertices)
         parts = self.parts(nv)
-        fps = self.feature_points(nv)
+        points = self.feature_points(nv)
         pivots = self.pivots()
-        regions = self.regions(nv, fps, pivots)
+        regions = self.regions(nv, points, pivots)
         neck = self.neck()
         try:
             return Face.build(vertices=vertices, triangles=triangles, vertex_colors=colours,
-                              parts=parts, feature_points=fps, regions=regions, pivots=pivots,
+                              parts=parts, feature_points=points, regions=regions, pivots=pivots,
                               neck=neck)
         except FaceModelError as exc:
             raise self.fail(exc.message) from exc
@@ -193,45 +193,52 @@ class _Reader:
             raise self.fail(f"neck normal {raw['normal']!r} and blend {blend!r} must be nonzero")
         return point, normal / length, blend
 
-    def regions(self, nv: int, fps: dict[str, int], pivots: dict[str, np.ndarray]) -> tuple:
+    def regions(
+        self, nv: int, points: dict[str, int], pivots: dict[str, np.ndarray]
+    ) -> tuple[Region, ...]:
         raw = self.get("regions", list)
-        out, names = [], set()
+        out: list[Region] = []
+        names: set[str] = set()
         for i, item in enumerate(raw):
-            where = f"regions[{i}]"
             if not isinstance(item, dict) or not isinstance(item.get("name"), str):
-                raise self.fail(f"{where} must be an object with a name")
-            name = item["name"]
-            where = f"region {name!r}"
-            if name in names:
-                raise self.fail(f"{where} is defined twice")
-            names.add(name)
-            deformer = item.get("deformer")
-            if deformer not in DEFORMERS:
-                raise self.fail(f"{where} has deformer {deformer!r}; known: {DEFORMERS}")
-            controls = item.get("feature_points")
-            if not isinstance(controls, list) or not controls:
-                raise self.fail(f"{where} needs a non-empty list of feature_points")
-            for c in controls:
-                if c not in fps:
-                    raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
-            vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
-            anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors",
-                                   allow_empty=True)
-            weights = np.zeros(0, np.float32)
-            pivot = ""
-            if deformer == "rbf" and len(controls) + anchors.size < 2:
-                raise self.fail(f"{where}: an RBF needs at least two sources")
-            if deformer in ("weights", "eyelid"):
-                if len(controls) != 1:
-                    raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
-                weights = np.asarray(item.get("weights", []), dtype=np.float64)
-                if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
-                    raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
-            if deformer == "eyelid":
-                pivot = str(item.get("pivot"))
-                if pivot not in pivots:
-                    raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
-            out.append(Region(name=name, deformer=deformer, feature_points=tuple(controls),
-                              vertices=vertices, anchors=anchors,
-                              weights=weights.astype(np.float32), pivot=pivot))
+                raise self.fail(f"regions[{i}] must be an object with a name")
+            if item["name"] in names:
+                raise self.fail(f"region {item['name']!r} is defined twice")
+            names.add(item["name"])
+            out.append(self.region(item, nv, points, pivots))
         return tuple(out)
+
+    def region(
+        self, item: dict[str, Any], nv: int, points: dict[str, int],
+        pivots: dict[str, np.ndarray],
+    ) -> Region:
+        """One entry of ``regions`` (an object with a string ``name``)."""
+        where = f"region {item['name']!r}"
+        deformer = item.get("deformer")
+        if deformer not in DEFORMERS:
+            raise self.fail(f"{where} has deformer {deformer!r}; known: {DEFORMERS}")
+        controls = item.get("feature_points")
+        if not isinstance(controls, list) or not controls:
+            raise self.fail(f"{where} needs a non-empty list of feature_points")
+        for c in controls:
+            if c not in points:
+                raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
+        vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
+        anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors", allow_empty=True)
+        weights = np.zeros(0, np.float32)
+        pivot = ""
+        if deformer == "rbf" and len(controls) + anchors.size < 2:
+            raise self.fail(f"{where}: an RBF needs at least two sources")
+        if deformer in ("weights", "eyelid"):
+            if len(controls) != 1:
+                raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
+            weights = np.asarray(item.get("weights", []), dtype=np.float64)
+            if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
+                raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
+        if deformer == "eyelid":
+            pivot = str(item.get("pivot"))
+            if pivot not in pivots:
+                raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
+        return Region(name=item["name"], deformer=deformer, feature_points=tuple(controls),
+                      vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
+                      pivot=pivot)

@@ -38,9 +38,22 @@ __all__ = ["PART_NAMES", "Face", "Part", "Region"]
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
 LINEAR_DEFORMERS = ("cosine", "rbf", "weights")
 DEFORMERS = (*LINEAR_DEFORMERS, "eyelid")
-_EYELID_FAPS = {"3.1": 19, "3.2": 20, "3.3": 21, "3.4": 22}
-_EYES = (("eye_l", 23, 25, 27), ("eye_r", 24, 26, 28))
+# The rigid steps address FAPs by their names in the standard's table (facelib.mpeg4).
+# Eyelid feature point -> the FAP that closes that lid (step 2).
+_EYELID_FAPS = {"3.1": "close_t_l_eyelid", "3.2": "close_t_r_eyelid",
+                "3.3": "close_b_l_eyelid", "3.4": "close_b_r_eyelid"}
+# Eyeball part -> its yaw, pitch and thrust FAPs (step 3).
+_EYES = (("eye_l", "yaw_l_eyeball", "pitch_l_eyeball", "thrust_l_eyeball"),
+         ("eye_r", "yaw_r_eyeball", "pitch_r_eyeball", "thrust_r_eyeball"))
+_EYE_THRUSTS = frozenset(thrust for *_, thrust in _EYES)
+_JAW = ("open_jaw", "thrust_jaw", "shift_jaw")  # step 4; open_jaw moves point 2.1
+_HEAD = ("head_pitch", "head_yaw", "head_roll")  # step 5
 _BLOCK = 32  # frames deformed together
+
+
+def _column(name: str) -> int:
+    """The 0-based column of the FAP called ``name`` in a frame of 84 values."""
+    return fap(name).index
 
 
 def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
@@ -123,7 +136,7 @@ class _Rigid:
 
     lids: _Lids
     # per eye: columns (3K,), rest shape about the centre (K, 3) float32, the centre
-    # repeated (3K,) float32, FAP numbers of yaw, pitch and thrust
+    # repeated (3K,) float32, 0-based FAP columns of yaw, pitch and thrust
     eyes: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, int, int, int], ...]
     jaw_x: np.ndarray
     jaw_y: np.ndarray
@@ -190,64 +203,27 @@ class Face:
         """
         verts = _readonly(vertices, np.float32)
         tris = _readonly(triangles, np.int32)
-        fps = MappingProxyType(dict(feature_points))
-        fapu = MappingProxyType(compute_fapu(verts, fps))
-        part_map = {}
-        for name, part_ids in parts.items():
-            ids = _readonly(part_ids, np.int32)
-            inside = np.zeros(len(verts), bool)
-            inside[ids] = True
-            part_map[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+        points = MappingProxyType(dict(feature_points))
+        fapu = MappingProxyType(compute_fapu(verts, points))
+        part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
-        operator = _compile(verts, tris, fps, fapu, regions)
-        for region in regions:
-            for eye in ("eye_l", "eye_r"):
-                if np.isin(region.vertices, part_map[eye].vertex_ids).any():
-                    raise FaceModelError(
-                        f"region {region.name!r} contains vertices of {eye}; eyeballs are "
-                        "rigid and move only with FAP 23-28"
-                    )
+        operator = _compile(verts, tris, points, fapu, regions)
+        _check_eyes_rigid(regions, part_map)
         columns = np.unique(operator.indices).astype(np.int64)
-        dense = operator[:, columns].toarray().astype(np.float32)
-        head = pivot_map["head"]
-        point, normal, blend = neck
-        height = (verts.astype(np.float64) - point) @ normal
-        t = np.clip(height / blend, 0.0, 1.0)
-        head_w = t * t * (3 - 2 * t)
-        jaw_ids = np.concatenate(
-            [part_map["teeth_lower"].vertex_ids, part_map["tongue"].vertex_ids])
-        rigid_parts = _Rigid(
-            lids=_lids(verts, fps, fapu, regions, pivot_map),
-            eyes=tuple(
-                (_columns(part_map[name].vertex_ids),
-                 (verts[part_map[name].vertex_ids] - pivot_map[name]).astype(np.float32),
-                 np.tile(pivot_map[name].astype(np.float32), part_map[name].vertex_ids.size),
-                 yaw, pitch, thrust)
-                for name, yaw, pitch, thrust in _EYES
-            ),
-            jaw_x=_columns(jaw_ids, "x"),
-            jaw_y=_columns(jaw_ids, "y"),
-            jaw_z=_columns(jaw_ids, "z"),
-            jaw_pivot=pivot_map["jaw"],
-            chin=verts[fps["2.1"]].astype(np.float64),
-            head_pivot=head,
-            head_tiled=np.tile(head.astype(np.float32), len(verts)),
-            head_weights=head_w[head_w < 1.0].astype(np.float32),
-            neck=_columns(np.nonzero(head_w < 1.0)[0]),
-        )
         return cls(
             vertices=verts,
             triangles=tris,
             vertex_colors=_readonly(vertex_colors, np.float32),
             parts=MappingProxyType(part_map),
-            feature_points=fps,
+            feature_points=points,
             fapu=fapu,
             regions=tuple(regions),
             pivots=MappingProxyType(pivot_map),
             operator=operator,
             _columns=columns,
-            _dense=dense,
-            _rigid=rigid_parts,
+            _dense=operator[:, columns].toarray().astype(np.float32),
+            _rigid=_rigid(verts, points=points, fapu=fapu, regions=regions, parts=part_map,
+                          pivots=pivot_map, neck=neck),
         )
 
     @property
@@ -305,7 +281,7 @@ class Face:
         au = self.fapu["AU"]
         flat = pos.reshape(len(f), -1)
         for columns, local, tiled, yaw, pitch, thrust in self._rigid.eyes:
-            y, p, t = f[:, yaw - 1] * au, f[:, pitch - 1] * au, f[:, thrust - 1]
+            y, p, t = f[:, yaw] * au, f[:, pitch] * au, f[:, thrust]
             if not (y.any() or p.any() or t.any()):
                 continue
             rot = rigid.rotation_matrices(p, y, np.zeros_like(p)).astype(np.float32)
@@ -316,7 +292,7 @@ class Face:
 
     def _move_jaw(self, pos: np.ndarray, f: np.ndarray) -> None:
         r = self._rigid
-        open_, thrust, shift = f[:, 2], f[:, 13], f[:, 14]
+        open_, thrust, shift = (f[:, _column(name)] for name in _JAW)
         if not (open_.any() or thrust.any() or shift.any()):
             return
         flat = pos.reshape(len(f), -1)
@@ -331,7 +307,7 @@ class Face:
         """Rotate the block ``pos`` about the head pivot into ``out`` (same shape)."""
         r = self._rigid
         au = self.fapu["AU"]
-        pitch, yaw, roll = f[:, 47] * au, f[:, 48] * au, f[:, 49] * au
+        pitch, yaw, roll = (f[:, _column(name)] * au for name in _HEAD)
         if not (pitch.any() or yaw.any() or roll.any()):
             out[:] = pos
             return
@@ -355,34 +331,17 @@ def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.nda
 
 
 def _compile(
-    verts: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int],
+    verts: np.ndarray, triangles: np.ndarray, points: Mapping[str, int],
     fapu: Mapping[str, float], regions: tuple[Region, ...],
 ) -> sp.csr_array:
     """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP."""
     nv = len(verts)
-    pos = verts.astype(np.float64)
-    # per feature point: list of (member ids, weights) from every linear region it controls
-    carried: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
-    for region in regions:
-        if region.deformer not in LINEAR_DEFORMERS:
-            continue
-        members = region.vertices.astype(np.int64)
-        controls = pos[[fps[f] for f in region.feature_points]]
-        if region.deformer == "cosine":
-            edge = pos[_edge(members, triangles, nv)]
-            w = raised_cosine_weights(pos[members], controls, edge=edge)
-        elif region.deformer == "rbf":
-            w = rbf_weights(pos[members], controls, pos[region.anchors])
-        else:
-            w = explicit_weights(region.weights)
-        for k, fp_id in enumerate(region.feature_points):
-            keep = w[:, k] != 0
-            carried.setdefault(fp_id, []).append((members[keep], w[keep, k]))
+    carried = _carried(verts, triangles, points, regions)
     rows, cols, vals = [], [], []
     for f in fap_table():
-        if f.kind != "translation" or f.fapu not in fapu or f.id in _EYELID_FAPS.values():
+        if f.kind != "translation" or f.fapu not in fapu or f.name in _EYELID_FAPS.values():
             continue
-        if f.id in (27, 28):  # eyeball thrust moves the whole eye (rigid step)
+        if f.name in _EYE_THRUSTS:  # eyeball thrust moves the whole eye (rigid step)
             continue
         fp_id = f.feature_points[0]
         scale = fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
@@ -404,8 +363,35 @@ def _compile(
     return out
 
 
+def _carried(
+    verts: np.ndarray, triangles: np.ndarray, points: Mapping[str, int],
+    regions: tuple[Region, ...],
+) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
+    """Per feature point: (member ids (K,) int64, weights (K,) float64) of every linear
+    region it controls, zero weights dropped."""
+    nv = len(verts)
+    pos = verts.astype(np.float64)
+    carried: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    for region in regions:
+        if region.deformer not in LINEAR_DEFORMERS:
+            continue
+        members = region.vertices.astype(np.int64)
+        controls = pos[[points[p] for p in region.feature_points]]
+        if region.deformer == "cosine":
+            edge = pos[_edge(members, triangles, nv)]
+            w = raised_cosine_weights(pos[members], controls, edge=edge)
+        elif region.deformer == "rbf":
+            w = rbf_weights(pos[members], controls, pos[region.anchors])
+        else:
+            w = explicit_weights(region.weights)
+        for k, fp_id in enumerate(region.feature_points):
+            keep = w[:, k] != 0
+            carried.setdefault(fp_id, []).append((members[keep], w[keep, k]))
+    return carried
+
+
 def _lids(
-    verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
+    verts: np.ndarray, points: Mapping[str, int], fapu: Mapping[str, float],
     regions: tuple[Region, ...], pivots: Mapping[str, np.ndarray],
 ) -> _Lids:
     lid_regions = [r for r in regions if r.deformer == "eyelid"]
@@ -433,7 +419,64 @@ def _lids(
         # the FAP prescribes the vertical motion of the lid point; sliding over the eye,
         # the rotation decides its depth
         hinges.append((f.index, fapu[f.fapu] * f.direction[1], pivots[region.pivot],
-                       verts[fps[fp_id]].astype(np.float64)))
+                       verts[points[fp_id]].astype(np.float64)))
     centres = np.array([pivots[name] for name in pivot_of], np.float32).reshape(-1, 3)
     return _Lids(tuple(hinges), _columns(ids, "y"), _columns(ids, "z"), centres[:, 1],
                  centres[:, 2], weights)
+
+
+def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int) -> dict[str, Part]:
+    """Parts with read-only vertex ids and the triangles whose corners all lie in them."""
+    out = {}
+    for name, part_ids in parts.items():
+        ids = _readonly(part_ids, np.int32)
+        inside = np.zeros(n_vertices, bool)
+        inside[ids] = True
+        out[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+    return out
+
+
+def _check_eyes_rigid(regions: tuple[Region, ...], parts: Mapping[str, Part]) -> None:
+    """FaceModelError if a region would deform an eyeball (they only rotate, step 3)."""
+    for region in regions:
+        for eye in ("eye_l", "eye_r"):
+            if np.isin(region.vertices, parts[eye].vertex_ids).any():
+                raise FaceModelError(
+                    f"region {region.name!r} contains vertices of {eye}; eyeballs are "
+                    "rigid and move only with FAP 23-28"
+                )
+
+
+def _rigid(
+    verts: np.ndarray, *, points: Mapping[str, int], fapu: Mapping[str, float],
+    regions: tuple[Region, ...], parts: Mapping[str, Part],
+    pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float],
+) -> _Rigid:
+    """Precompute steps 2-5. The head's weight fades with a smoothstep over ``neck``'s
+    blend distance above its plane."""
+    head = pivots["head"]
+    point, normal, blend = neck
+    height = (verts.astype(np.float64) - point) @ normal
+    t = np.clip(height / blend, 0.0, 1.0)
+    head_w = t * t * (3 - 2 * t)
+    jaw_ids = np.concatenate([parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
+    chin = fap(_JAW[0]).feature_points[0]
+    return _Rigid(
+        lids=_lids(verts, points, fapu, regions, pivots),
+        eyes=tuple(
+            (_columns(parts[name].vertex_ids),
+             (verts[parts[name].vertex_ids] - pivots[name]).astype(np.float32),
+             np.tile(pivots[name].astype(np.float32), parts[name].vertex_ids.size),
+             _column(yaw), _column(pitch), _column(thrust))
+            for name, yaw, pitch, thrust in _EYES
+        ),
+        jaw_x=_columns(jaw_ids, "x"),
+        jaw_y=_columns(jaw_ids, "y"),
+        jaw_z=_columns(jaw_ids, "z"),
+        jaw_pivot=pivots["jaw"],
+        chin=verts[points[chin]].astype(np.float64),
+        head_pivot=head,
+        head_tiled=np.tile(head.astype(np.float32), len(verts)),
+        head_weights=head_w[head_w < 1.0].astype(np.float32),
+        neck=_columns(np.nonzero(head_w < 1.0)[0]),
+    )

@@ -17,7 +17,7 @@ from facelib.cues import GazeCue
 from facelib.errors import ParameterError
 from facelib.gaze.behaviours import BoundBehaviour, bind_behaviour, merge_behaviours
 from facelib.gaze.blinks import blink_closure, schedule_blinks
-from facelib.gaze.events import Blink, HeadMove, Saccade
+from facelib.gaze.events import Blink, GazeEvent, HeadMove, Saccade
 from facelib.gaze.model import gaze_model
 from facelib.gaze.motion import Motion
 from facelib.gaze.planner import Planner
@@ -63,10 +63,9 @@ class GazeAnimation:
     blink_lids: tuple[float, float]
 
     @property
-    def events(self) -> tuple[Saccade | Blink | HeadMove, ...]:
+    def events(self) -> tuple[GazeEvent, ...]:
         """Saccades (including pursuit catch-ups), blinks and head moves by start time."""
-        merged: list[Saccade | Blink | HeadMove] = [*self.saccades, *self.blinks,
-                                                    *self.head_moves]
+        merged: list[GazeEvent] = [*self.saccades, *self.blinks, *self.head_moves]
         return tuple(sorted(merged, key=lambda e: e.start))
 
 
@@ -128,6 +127,24 @@ def animate(
     gaze_rng, blink_rng = np.random.default_rng(seed).spawn(2)
     planner = Planner(gaze_rng, _mode_lookup(speaking, fps, n_frames))
 
+    segments = _segments(bound, default, seconds)
+    for t0, t1, behaviour in segments:
+        if t0 >= seconds:
+            break
+        engine = getattr(planner, behaviour.engine)
+        engine(t0, min(t1, seconds), behaviour)
+
+    blinks = schedule_blinks(
+        blink_rng, seconds=seconds, rate_per_min=planner.blink_rate, evoked_at=planner.evoked
+    )
+    return _render(planner, blinks, fps=fps, n_frames=n_frames, vergence=None)
+
+
+def _segments(
+    bound: Sequence[tuple[GazeCue, BoundBehaviour]], default: BoundBehaviour, seconds: float
+) -> list[tuple[float, float, BoundBehaviour]]:
+    """(start s, end s, behaviour) runs covering ``[0, seconds]``: each cue until the next
+    cue starts, the default behaviour in the gaps and after the last cue."""
     segments: list[tuple[float, float, BoundBehaviour]] = []
     t = 0.0
     for k, (cue, behaviour) in enumerate(bound):
@@ -142,16 +159,7 @@ def animate(
         t = max(t, end)
     if t < seconds or not segments:
         segments.append((t, max(seconds, t), default))
-    for t0, t1, behaviour in segments:
-        if t0 >= seconds:
-            break
-        engine = getattr(planner, behaviour.engine)
-        engine(t0, min(t1, seconds), behaviour)
-
-    blinks = schedule_blinks(
-        blink_rng, seconds=seconds, rate_per_min=planner.blink_rate, evoked_at=planner.evoked
-    )
-    return _render(planner, blinks, fps=fps, n_frames=n_frames, vergence=None)
+    return segments
 
 
 def _render(

@@ -58,7 +58,7 @@ def timeline_to_json(timeline: SpeechTimeline) -> dict[str, Any]:
 def timeline_from_json(data: Mapping[str, Any]) -> SpeechTimeline:
     """Inverse of :func:`timeline_to_json` (times rounded to whole ms)."""
     try:
-        def ms(x: Any) -> int:
+        def ms(x: float | str) -> int:
             return round(float(x) * 1000)
 
         phones = tuple(Span(p["phone"], ms(p["start"]), ms(p["end"])) for p in data["phones"])
