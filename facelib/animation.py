@@ -12,6 +12,7 @@ from types import MappingProxyType
 import numpy as np
 
 from facelib import expressions, gaze, visemes
+from facelib.checks import check_seed
 from facelib.cues import Storyboard
 from facelib.fdl import load
 from facelib.gaze.events import GazeEvent
@@ -61,7 +62,7 @@ def animate(
     frame at its very end.
     """
     if seed is not None:
-        storyboard = replace(storyboard, seed=int(seed))
+        storyboard = replace(storyboard, seed=check_seed(seed))
     rules = rules or SyncRules.load()
     fps = storyboard.fps
     speech = visemes.animate(storyboard.speech, fps=fps) if storyboard.speech else None

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import facelib
 from facelib.errors import FacelibError
-from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4 import DIALECTS, FapStream, fap, read_fap, read_fap_file, write_fap
 
 if TYPE_CHECKING:
     from facelib.animation import Animation
@@ -149,8 +149,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("story", help="the .fdl storyboard")
     run.add_argument("-o", "--output", help="the .fap file (default: the storyboard's output)")
     run.add_argument("--seed", type=int, help="seed of the random processes")
-    run.add_argument("--dialect", default="standard",
-                     choices=("standard", "xface", "greta", "extended"))
+    run.add_argument("--dialect", default="standard", choices=DIALECTS)
     run.set_defaults(run=_run)
 
     render = commands.add_parser("render", help="render a storyboard (or .fap) to video")

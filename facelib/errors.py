@@ -17,6 +17,7 @@ __all__ = [
     "FapFormatError",
     "FdlError",
     "FdlWarning",
+    "FileError",
     "MissingExtraError",
     "ParameterError",
     "RenderError",
@@ -77,6 +78,18 @@ class SpeechError(FacelibError):
 
 class RenderError(FacelibError):
     """Rendering or video encoding failed (no OpenGL platform, encoder error, ...)."""
+
+
+class FileError(FacelibError, OSError):
+    """A file or folder could not be read or written: the operating system's error
+    (``OSError``, kept as ``__cause__``) with the path it concerns."""
+
+    @classmethod
+    def wrap(cls, exc: OSError, what: str, path: str | Path) -> FileError:
+        """``FileError`` for ``exc`` raised while doing ``what`` ("write", "read") at
+        ``path``."""
+        reason = exc.strerror or str(exc)
+        return cls(f"cannot {what}: {reason}", path=path)
 
 
 class MissingExtraError(FacelibError, ImportError):

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from facelib.checks import check_fps
+from facelib.checks import check_count, check_fps, check_number, check_seed
 from facelib.cues import GazeCue
 from facelib.errors import ParameterError
 from facelib.gaze.behaviours import BoundBehaviour, bind_behaviour, merge_behaviours
@@ -69,10 +69,10 @@ class GazeAnimation:
         return tuple(sorted(merged, key=lambda e: e.start))
 
 
-def _check_frames(fps: float, n_frames: int) -> None:
-    check_fps(fps)
-    if not isinstance(n_frames, (int, np.integer)) or n_frames < 0:
-        raise ParameterError(f"n_frames must be an integer >= 0, got {n_frames!r}")
+def _checked(fps: object, n_frames: object, seed: object) -> tuple[float, int, int]:
+    """The shared argument checks: ``ParameterError`` for a bad frame rate, frame count or
+    seed."""
+    return check_fps(fps), check_count("n_frames", n_frames), check_seed(seed)
 
 
 def _mode_lookup(speaking: np.ndarray | None, fps: float, n_frames: int):
@@ -116,7 +116,7 @@ def animate(
     FdlError: unknown behaviour (with a suggestion) or bad values, with the cue's file/line.
     ParameterError: bad fps, n_frames or speaking.
     """
-    _check_frames(fps, n_frames)
+    fps, n_frames, seed = _checked(fps, n_frames, seed)
     library = merge_behaviours(behaviours)
     bound = [
         (c, bind_behaviour(c.behaviour, c.args, library=library, origin=c.origin))
@@ -233,8 +233,8 @@ def simulate(
     """Run one behaviour for ``seconds`` as an eye-script tuple would, e.g.
     ``simulate("default", "talking", 0.9, seconds=600)``. ``speaking`` says whether the
     character talks throughout (for mode ``auto``)."""
-    if not (isinstance(seconds, (int, float)) and np.isfinite(seconds) and seconds > 0):
-        raise ParameterError(f"seconds must be a positive number, got {seconds!r}")
+    seconds = check_number("seconds", seconds, low=0.0, low_open=True)
+    fps = check_fps(fps)
     n_frames = round(seconds * fps)
     cue = GazeCue(behaviour, tuple(args), 0, round(seconds * 1000))
     talk = np.full(n_frames, bool(speaking))
@@ -268,8 +268,7 @@ def pursue(
     target = np.asarray(target_deg, dtype=float)
     if target.ndim != 2 or target.shape[1] != 2 or not np.isfinite(target).all():
         raise ParameterError(f"target_deg must be a finite (n_frames, 2) array, got {target.shape}")
-    n_frames = target.shape[0]
-    _check_frames(fps, n_frames)
+    fps, n_frames, seed = _checked(fps, target.shape[0], seed)
     planner = Planner(np.random.default_rng(seed).spawn(2)[0], lambda t: "listening")
     if start_deg != (0.0, 0.0):
         planner.gaze = Motion(start_deg)

@@ -41,7 +41,6 @@ from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 __all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
 
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
-_WRITE_DIALECTS = ("standard", "xface", "greta", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
 _GROUP = {0: len(VISEME_FIELDS), 1: len(EXPRESSION_FIELDS)}
 
@@ -329,25 +328,28 @@ def write_fap(
     path:
         The file to write.
     dialect:
-        ``"standard"`` (68 mask tokens, integer values: every player reads it),
-        ``"xface"`` (standard plus the FAP 1/2 token groups), ``"greta"`` (69 mask
-        tokens) or ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2).
+        Any of :data:`DIALECTS`, each read back as that dialect: ``"standard"`` (68 mask
+        tokens, integer values: every player reads it), ``"xface"`` (68 mask tokens, values
+        with decimals, plus the FAP 1/2 token groups), ``"greta"`` (69 mask tokens),
+        ``"vreng"`` (standard with frames numbered from 1, tab-separated) or
+        ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2).
     name:
         The header's name; default: the file's stem. Spaces become underscores.
 
     Returns the path written.
     """
-    if dialect not in _WRITE_DIALECTS:
-        raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {_WRITE_DIALECTS}")
+    if dialect not in DIALECTS:
+        raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
     path = Path(path)
     label = "_".join((name if name is not None else path.stem).split()) or "facelib"
-    width = {"standard": N_STANDARD_FAPS, "xface": N_STANDARD_FAPS,
-             "greta": _GRETA_MASK, "extended": N_FAPS}[dialect]
+    width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
-    values = np.rint(stream.values).astype(np.int64)
+    values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
+        str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
+    first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
     mask = np.zeros((stream.n_frames, width), bool)
     mask[:, : min(width, N_FAPS)] = stream.mask[:, : min(width, N_FAPS)]
     if not high_level:
@@ -357,15 +359,21 @@ def write_fap(
         mask[:, 1] &= stream.expression is not None
     out = [f"2.1 {label} {int(stream.fps)} {stream.n_frames}"]
     for i in range(stream.n_frames):
-        out.append(" ".join("1" if m else "0" for m in mask[i]))
-        tokens = [str(i)]
+        out.append(sep.join("1" if m else "0" for m in mask[i]))
+        tokens = [str(i + first)]
         for slot in np.flatnonzero(mask[i]):
             if slot == 0:
                 tokens += [str(int(v)) for v in stream.viseme[i]]  # type: ignore[index]
             elif slot == 1:
                 tokens += [str(int(v)) for v in stream.expression[i]]  # type: ignore[index]
             else:
-                tokens.append(str(values[i, slot]))
-        out.append(" ".join(tokens))
+                tokens.append(values[i * N_FAPS + slot])
+        out.append(sep.join(tokens))
     write_text_atomic(path, "\n".join(out) + "\n")
     return path
+
+
+def _decimal(value: float) -> str:
+    """``value`` with up to 3 decimals and at least one (``100.0``, ``-12.5``)."""
+    text = f"{value:.3f}".rstrip("0")
+    return text + "0" if text.endswith(".") else text

@@ -3,7 +3,8 @@ while a writer drafts a storyboard before the voice is recorded."""
 
 from __future__ import annotations
 
-from facelib.errors import MissingExtraError, ParameterError, SpeechError
+from facelib.checks import check_number
+from facelib.errors import MissingExtraError, SpeechError
 from facelib.speech.pronounce import letter_to_sound, pronounce, tokenize
 from facelib.speech.tables import pauses as pause_table
 from facelib.speech.tables import phone_durations
@@ -31,8 +32,7 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
     """Phones and words of ``text`` spoken at ``rate`` (1.0 is about 160 words per
     minute; 2.0 twice as fast), from the duration model (``phone_durations.csv``, pauses at
     punctuation from ``pauses.csv``). Times in ms from 0; ``source="durations"``."""
-    if not (isinstance(rate, (int, float)) and 0.25 <= rate <= 4):
-        raise ParameterError(f"speaking rate must be between 0.25 and 4, got {rate!r}")
+    rate = check_number("rate", rate, low=0.25, high=4.0)
     pauses = pause_table()
     table = phone_durations()
     tokens = tokenize(text)

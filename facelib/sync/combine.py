@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from facelib.checks import check_seed
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import ANGLE_UNIT, fap
 from facelib.mpeg4.track import FapTrack
@@ -124,6 +125,7 @@ def combine(
     blink_lids: the (upper, lower) lid values at full closure.
     speaking: ``(n_frames,) bool`` where the character talks (livelier head noise).
     """
+    seed = check_seed(seed)
     rules = rules or SyncRules.load()
     face = blend(expressions, visemes, weight_a=rules.mouth[0], weight_b=rules.mouth[1])
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
