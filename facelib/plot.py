@@ -6,6 +6,7 @@ Needs matplotlib (the ``plot`` extra); it is imported on first use.
 from __future__ import annotations
 
 import os
+import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,7 +15,7 @@ import numpy as np
 from facelib.atomic import atomic_path
 from facelib.errors import MissingExtraError
 from facelib.mpeg4.stream import FapStream
-from facelib.mpeg4.tables import fap
+from facelib.mpeg4.tables import fap, fap_groups, fap_table
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -24,18 +25,19 @@ if TYPE_CHECKING:
 
 __all__ = ["REGIONS", "plot_curves"]
 
-REGIONS: tuple[tuple[str, tuple[int, ...]], ...] = (
-    ("jaw and inner lips", tuple(range(3, 19))),
-    ("outer lips", tuple(range(51, 61))),
-    ("extended lips and nose", tuple(range(69, 85))),
-    ("eyelids (IRISD)", (19, 20, 21, 22)),
-    ("eyeballs (AU)", tuple(range(23, 31))),
-    ("eyebrows", tuple(range(31, 39))),
-    ("cheeks, nose, ears", (*range(39, 43), *range(61, 69))),
-    ("tongue", tuple(range(43, 48))),
-    ("head (AU)", (48, 49, 50)),
-)
-"""Panels: a title and the FAP ids it shows."""
+def _regions() -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """One panel per FAP group of the standard (``fap_groups``) that moves the face: group
+    1 (visemes and expressions) is expanded into the others."""
+    groups = fap_groups()
+    return tuple(
+        (name, tuple(f.id for f in fap_table() if f.group == group))
+        for group, name in groups.items()
+        if group != 1
+    )
+
+
+REGIONS: tuple[tuple[str, tuple[int, ...]], ...] = _regions()
+"""Panels: a title (the FAP group's name) and the FAP ids it shows."""
 
 
 def plot_curves(
@@ -73,7 +75,7 @@ def plot_curves(
         for f in faps:
             info = fap(f)
             ax.plot(t, stream.values[:, f - 1], lw=1.1, label=f"{f} {info.name} ({info.fapu})")
-        ax.set_ylabel(name, fontsize=8)
+        ax.set_ylabel(textwrap.fill(name, 24), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
         if faps:
