@@ -12,7 +12,7 @@ from facelib.errors import SpeechError
 from facelib.mpeg4.tables import fap
 from facelib.visemes import animate, driven_faps, viseme_targets
 
-FIXTURES = Path(__file__).parent / "fixtures"
+FIXTURES = Path(__file__).parents[1] / "data" / "speech" / "alignment"
 
 
 def test_text_only_track_shape_weights_and_offset():

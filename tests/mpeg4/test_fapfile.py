@@ -12,7 +12,7 @@ from facelib import FacelibError, FapFormatError, FapStream, ParameterError, rea
 from facelib.errors import FacelibWarning
 from facelib.mpeg4 import read_fap_file
 
-DATA = Path(__file__).parent / "data" / "fap"
+DATA = Path(__file__).parents[1] / "data" / "fap"
 
 
 def test_xface_dialect_crlf_floats_and_token_groups():

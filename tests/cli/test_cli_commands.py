@@ -9,7 +9,7 @@ import pytest
 from facelib import read_fap
 from facelib.cli import main
 
-ROOT = Path(__file__).parent.parent
+ROOT = Path(__file__).parents[2]
 SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
 
 
