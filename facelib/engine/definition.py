@@ -8,12 +8,12 @@ or float 0-1).
 from __future__ import annotations
 
 import json
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from facelib import data
 from facelib.engine.face import DEFORMERS, PART_NAMES, Face, Region
 from facelib.errors import FaceModelError
 from facelib.mpeg4.tables import fap_table, feature_point_table
@@ -36,7 +36,7 @@ def required_feature_points() -> tuple[str, ...]:
 
 
 def _default_path() -> Path:
-    return Path(str(resources.files("facelib.data").joinpath("head", "default_head.json")))
+    return Path(str(data.path("head/default_head.json")))
 
 
 def default_face() -> Face:
@@ -107,8 +107,8 @@ class _Reader:
     def mesh(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         mesh_path = self.path.parent / self.get("mesh", str)
         try:
-            with np.load(mesh_path, allow_pickle=False) as data:
-                arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
+            with np.load(mesh_path, allow_pickle=False) as arrays_file:
+                arrays = {k: arrays_file[k] for k in ("vertices", "triangles", "vertex_colors")}
         except (OSError, ValueError) as exc:
             raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
         except KeyError as exc:

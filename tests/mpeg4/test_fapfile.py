@@ -10,7 +10,7 @@ from hypothesis.extra import numpy as hnp
 
 from facelib import FacelibError, FapFormatError, FapStream, ParameterError, read_fap, write_fap
 from facelib.errors import FacelibWarning
-from facelib.mpeg4 import read_fap_file
+from facelib.mpeg4 import DIALECTS, read_fap_file
 
 DATA = Path(__file__).parents[1] / "data" / "fap"
 
@@ -200,3 +200,16 @@ def test_malformed_files_raise_fap_format_error(tmp_path, text, message, line):
 def test_unreadable_file(tmp_path):
     with pytest.raises(FapFormatError, match="cannot read"):
         read_fap(tmp_path / "absent.fap")
+
+
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_every_dialect_read_back_is_the_dialect_written(tmp_path, dialect):
+    values = np.zeros((3, 84), np.float32)
+    values[:, 2] = [0.0, 120.25, -40.5]
+    stream = FapStream(25, values)
+    file = read_fap_file(write_fap(stream, tmp_path / "a.fap", dialect=dialect))
+    assert file.dialect == dialect
+    assert file.stream.n_frames == 3
+    exact = dialect == "xface"  # the only dialect with decimals
+    expected = values[:, 2] if exact else np.rint(values[:, 2])
+    assert file.stream.values[:, 2].tolist() == expected.tolist()
