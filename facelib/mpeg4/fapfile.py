@@ -38,7 +38,7 @@ from facelib.errors import FacelibWarning, FapFormatError, ParameterError
 from facelib.mpeg4.stream import EXPRESSION_FIELDS, VISEME_FIELDS, FapStream
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
-__all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
+__all__ = ["DIALECTS", "FapFile", "format_fap", "read_fap", "read_fap_file", "write_fap"]
 
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _WRITE_DIALECTS = ("standard", "xface", "greta", "extended")
@@ -333,13 +333,21 @@ def write_fap(
 
     Returns the path written.
     """
+    path = Path(path)
+    text = format_fap(stream, dialect=dialect, name=name if name is not None else path.stem)
+    write_text_atomic(path, text)
+    return path
+
+
+def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "facelib") -> str:
+    """The text of a ``.fap`` file holding ``stream`` (see :func:`write_fap` for
+    ``dialect``); ``name`` goes into the header, spaces becoming underscores."""
     if dialect not in _WRITE_DIALECTS:
         raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {_WRITE_DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
-    path = Path(path)
-    label = "_".join((name if name is not None else path.stem).split()) or "facelib"
+    label = "_".join(name.split()) or "facelib"
     width = {"standard": N_STANDARD_FAPS, "xface": N_STANDARD_FAPS,
              "greta": _GRETA_MASK, "extended": N_FAPS}[dialect]
     high_level = dialect in ("xface", "extended")
@@ -363,5 +371,4 @@ def write_fap(
             else:
                 tokens.append(str(values[i, slot]))
         out.append(" ".join(tokens))
-    write_text_atomic(path, "\n".join(out) + "\n")
-    return path
+    return "\n".join(out) + "\n"
