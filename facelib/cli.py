@@ -307,7 +307,9 @@ def _render(args: argparse.Namespace, console: Console) -> int:
         if result.ok:
             console.status(f"wrote {result.output} in {result.seconds:.1f} s")
         else:
-            print(f"facelib: error: {result.source}: {result.error}", file=sys.stderr)
+            where = "" if str(Path(result.source).name) in str(result.error) else (
+                f"{result.source}: ")
+            print(f"facelib: error: {where}{result.error}", file=sys.stderr)
     failed = sum(not r.ok for r in results)
     if failed:
         print(f"facelib: {failed} of {len(results)} failed", file=sys.stderr)
