@@ -97,7 +97,7 @@ def _emit_text(text: str, out: str, console: Console, summary: str) -> None:
     from facelib.atomic import write_text_atomic
 
     write_text_atomic(out, text)
-    console.status(f"wrote {out} {summary}")
+    console.status(f"wrote {out} {summary}".rstrip())
 
 
 def _default_output(story: str, storyboard_output: Path | None, suffix: str) -> Path:
@@ -395,8 +395,9 @@ def _align(args: argparse.Namespace, console: Console) -> int:
         timeline_to_tsv,
     )
 
-    _check_suffix(args.output, (".json", ".tsv", ".sb"), "align")
+    _check_suffix(args.output, (".json", ".tsv", ".sb", ".lua", ".fdl"), "align")
     kind = args.format if args.output == STDOUT else Path(args.output).suffix[1:].lower()
+    kind = "sb" if kind in ("lua", "fdl") else kind
     text = args.text
     if args.text_file is not None:
         text = Path(args.text_file).read_text(encoding="utf-8")
@@ -406,7 +407,7 @@ def _align(args: argparse.Namespace, console: Console) -> int:
         "tsv": lambda: timeline_to_tsv(timeline),
         "sb": lambda: timeline_to_sentence(timeline, fps=args.fps),
     }[kind]()
-    _emit_text(formatted, args.output, console, f"({len(timeline)} visemes)")
+    _emit_text(formatted, args.output, console, "")
     return EXIT_OK
 
 
