@@ -50,6 +50,16 @@ class Animation:
     def __post_init__(self) -> None:
         object.__setattr__(self, "tracks", MappingProxyType(dict(self.tracks)))
 
+    def __repr__(self) -> str:
+        """One line: where it came from, its length and parts, never the arrays."""
+        source = self.storyboard.path.name if self.storyboard.path else "<storyboard>"
+        audio = f", audio={self.audio.name!r}" if self.audio is not None else ""
+        return (f"Animation({source!r}, frames={self.faps.n_frames}, fps={self.faps.fps:g}, "
+                f"duration={self.faps.duration:.3f}s, "
+                f"expressions={len(self.storyboard.expressions)}, "
+                f"gaze={len(self.storyboard.gaze)}, gaze_events={len(self.gaze_events)}"
+                f"{audio})")
+
 
 _STAGES = 4  # speech, expressions, gaze, synchronizer: the units of animate's progress
 
