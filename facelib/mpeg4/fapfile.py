@@ -325,9 +325,13 @@ def write_fap(
     path:
         The file to write.
     dialect:
-        ``"standard"`` (68 mask tokens, integer values: every player reads it),
-        ``"xface"`` (standard plus the FAP 1/2 token groups), ``"greta"`` (69 mask
-        tokens) or ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2).
+        ``"standard"`` (68 mask tokens, integer values: the recommended choice, read
+        correctly by Xface, Greta (Java and C++) and VREng), ``"xface"`` (standard plus
+        the FAP 1/2 token groups; warns when it writes them: Greta's Java reader and VREng
+        shift every later value), ``"greta"`` (69 mask tokens, the 69th always 0, as Greta
+        writes) or ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2;
+        only facelib reads it). Every dialect but ``extended`` warns, naming them, when it
+        drops extended FAPs 69-84 that carry values.
     name:
         The header's name; default: the file's stem. Spaces become underscores.
 
@@ -343,9 +347,12 @@ def write_fap(
     width = {"standard": N_STANDARD_FAPS, "xface": N_STANDARD_FAPS,
              "greta": _GRETA_MASK, "extended": N_FAPS}[dialect]
     high_level = dialect in ("xface", "extended")
+    _warn_dropped(stream, path, dialect)
     values = np.rint(stream.values).astype(np.int64)
     mask = np.zeros((stream.n_frames, width), bool)
-    mask[:, : min(width, N_FAPS)] = stream.mask[:, : min(width, N_FAPS)]
+    # Greta's 69th slot is unused: FAP 69 (an extended FAP) must never land there
+    kept = min(width, N_FAPS if dialect == "extended" else N_STANDARD_FAPS)
+    mask[:, :kept] = stream.mask[:, :kept]
     if not high_level:
         mask[:, :2] = False
     else:
@@ -365,3 +372,23 @@ def write_fap(
         out.append(" ".join(tokens))
     write_text_atomic(path, "\n".join(out) + "\n")
     return path
+
+
+def _warn_dropped(stream: FapStream, path: Path, dialect: str) -> None:
+    """Warn about what a dialect cannot carry: extended FAPs 69-84 outside ``extended``, and
+    the FAP 1/2 token groups of ``xface`` that Greta's Java reader and VREng misread."""
+    if dialect != "extended":
+        used = (stream.mask[:, N_STANDARD_FAPS:] & (stream.values[:, N_STANDARD_FAPS:] != 0))
+        dropped = [int(i) + N_STANDARD_FAPS + 1 for i in np.flatnonzero(used.any(axis=0))]
+        if dropped:
+            warnings.warn(
+                f"{path}: the {dialect} dialect has no extended FAPs; dropping FAP "
+                f"{', '.join(map(str, dropped))} (write dialect='extended' to keep them; "
+                "only facelib reads that dialect)", FacelibWarning, stacklevel=3)
+    if dialect == "xface" and stream.mask[:, :2].any() and (
+            stream.viseme is not None or stream.expression is not None):
+        warnings.warn(
+            f"{path}: the xface dialect writes FAP 1/2 as 4- and 6-token groups, which Greta's "
+            "Java reader and VREng read as one token each, shifting every later value of "
+            "the frame; dialect='standard' is read correctly by every player",
+            FacelibWarning, stacklevel=3)
