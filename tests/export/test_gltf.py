@@ -1,0 +1,92 @@
+"""glTF export: the file validates, and its morph targets and skin evaluated per the glTF
+specification reproduce ``Face.deform`` within 0.1 mm."""
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from facelib import FapStream
+from facelib.engine import default_face
+from facelib.export import export_gltf
+from facelib.mpeg4 import fap
+
+from gltf_eval import Gltf
+
+WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
+
+
+def busy_stream() -> FapStream:
+    """Every rigid step at once: jaw, lids, eyes, head, plus lips, brows and FAP 1/2."""
+    n = 12
+    t = np.linspace(0, 1, n)
+    values = np.zeros((n, 84), np.float32)
+    for name, amp in (("open_jaw", 500), ("thrust_jaw", 80), ("shift_jaw", -60),
+                      ("close_t_l_eyelid", 1000), ("close_t_r_eyelid", 700),
+                      ("close_b_l_eyelid", 300), ("yaw_l_eyeball", 20000),
+                      ("pitch_r_eyeball", -15000), ("thrust_l_eyeball", 100),
+                      ("head_pitch", 20000), ("head_yaw", -30000), ("head_roll", 12000),
+                      ("raise_l_i_eyebrow", 200), ("stretch_l_cornerlip", 150)):
+        values[:, fap(name).index] = amp * np.sin(np.pi * t)
+    mask = np.ones((n, 84), bool)
+    viseme = np.tile([10, 1, 40, 0], (n, 1))
+    expression = np.tile([1, 50, 0, 0, 0, 0], (n, 1))
+    return FapStream(25, values, mask, viseme, expression)
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    out = tmp_path_factory.mktemp("gltf") / "busy.glb"
+    return export_gltf(busy_stream(), out), busy_stream()
+
+
+def test_evaluated_gltf_matches_deform_within_a_tenth_of_a_millimetre(exported):
+    result, stream = exported
+    face = default_face()
+    want = face.deform(stream)
+    gltf = Gltf(result.path)
+    worst = 0.0
+    for frame in (0, 3, 6, 9, 11):
+        got = gltf.evaluate(frame)
+        for part, positions in zip(face.parts.values(), got, strict=True):
+            ids = np.sort(part.vertex_ids)
+            worst = max(worst, float(np.abs(positions - want[frame][ids]).max()))
+    assert worst < 1e-4, f"{worst * 1000:.4f} mm"
+    print(f"worst {worst * 1000:.5f} mm")
+    # the deformation is real: frame 6 moves the face by centimetres
+    assert np.abs(want[6] - face.vertices).max() > 0.01
+
+
+def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
+    result, _ = exported
+    g = Gltf(result.path).g
+    assert 3 in result.targets and 19 not in result.targets  # lids are joints, not targets
+    assert 48 not in result.targets and 1 not in result.targets
+    names = g.meshes[0].extras["targetNames"]
+    assert len(names) == len(result.targets) == len(g.meshes[0].primitives[0].targets)
+    assert all(g.accessors[t["POSITION"]].bufferView is None
+               for p in g.meshes[0].primitives for t in p.targets)
+    assert [p.material for p in g.meshes[0].primitives] == list(range(6))
+    extras = g.asset.extras["facelib"]
+    assert extras["n_frames"] == 12 and extras["fps"] == 25
+
+
+def test_speech_audio_is_copied_beside_and_named(tmp_path):
+    audio = Path(__file__).parents[2] / "examples" / "hello" / "hello.flac"
+    result = export_gltf(busy_stream(), tmp_path / "a.glb", audio=audio)
+    assert result.audio == tmp_path / "a.flac"
+    assert result.audio.read_bytes() == audio.read_bytes()
+    assert Gltf(result.path).g.asset.extras["facelib"]["audio"] == "a.flac"
+
+
+@pytest.mark.skipif(shutil.which("node") is None or not (WEB / "node_modules").exists(),
+                    reason="needs node and the npm packages (make setup)")
+def test_gltf_validator_reports_no_issue(exported):
+    result, _ = exported
+    run = subprocess.run(["node", str(WEB / "tools" / "validate.mjs"), str(result.path)],
+                         capture_output=True, text=True, check=False)
+    report = json.loads(run.stdout)
+    assert report["numErrors"] == 0 and report["numWarnings"] == 0, report["messages"][:5]
