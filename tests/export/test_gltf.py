@@ -19,9 +19,8 @@ from gltf_eval import Gltf
 WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
 
 
-def busy_stream() -> FapStream:
+def busy_stream(n: int = 12) -> FapStream:
     """Every rigid step at once: jaw, lids, eyes, head, plus lips, brows and FAP 1/2."""
-    n = 12
     t = np.linspace(0, 1, n)
     values = np.zeros((n, 84), np.float32)
     for name, amp in (("open_jaw", 500), ("thrust_jaw", 80), ("shift_jaw", -60),
