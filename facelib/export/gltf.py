@@ -181,8 +181,8 @@ def _skeleton(b: _Builder, rig: Rig, pose: Pose) -> list[int]:
     return list(range(first, first + len(rig.names)))
 
 
-def _animation(b: _Builder, mesh_node: int, joint_nodes: list[int], weights: np.ndarray,
-               pose: Pose, fps: float) -> None:
+def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: Pose, *,
+               fps: float, mesh_node: int = 0) -> None:
     """One keyframe per frame: morph weights and every joint transform that changes."""
     lib = b.lib
     n = len(weights)
@@ -261,8 +261,8 @@ def export_gltf(
     joint_nodes = _skeleton(b, rig, pose)
     g.scenes.append(lib.Scene(name="facelib", nodes=[0, joint_nodes[0]]))
     g.scene = 0
-    _animation(b, 0, joint_nodes, values / scales if len(rows) else values[:, :0], pose,
-               float(stream.fps))
+    _animation(b, joint_nodes, values / scales if len(rows) else values[:, :0], pose,
+               fps=float(stream.fps))
     blob = b.blob()
     g.buffers.append(lib.Buffer(byteLength=len(blob)))
     g.set_binary_blob(blob)

@@ -56,15 +56,14 @@ def export_html(
                            f"{WEB_DIR}")
     folder = Path(out_dir)
     folder.mkdir(parents=True, exist_ok=True)
-    stream, audio_path, _ = resolve_source(source, audio)
+    _, audio_path, offset = resolve_source(source, audio)
     result = export_gltf(source, folder / "face.glb", face=face, audio=audio_path)
     look = data.json_data("render_look.json")
     scene = {
         "glb": base64.b64encode(result.path.read_bytes()).decode("ascii"),
         "fps": result.fps, "nFrames": result.n_frames,
         "audio": result.audio.name if result.audio else None,
-        "audioOffset": float(getattr(source, "audio_offset", 0.0) or 0.0)
-        if audio is None else 0.0,
+        "audioOffset": offset,
         "look": {k: look[k] for k in ("lights", "ambient", "background", "camera")},
     }
     write_text_atomic(folder / "scene.js",

@@ -8,32 +8,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from gltf_eval import Gltf, busy_stream
 
-from facelib import FapStream
 from facelib.engine import default_face
 from facelib.export import export_gltf
-from facelib.mpeg4 import fap
-
-from gltf_eval import Gltf
 
 WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
-
-
-def busy_stream(n: int = 12) -> FapStream:
-    """Every rigid step at once: jaw, lids, eyes, head, plus lips, brows and FAP 1/2."""
-    t = np.linspace(0, 1, n)
-    values = np.zeros((n, 84), np.float32)
-    for name, amp in (("open_jaw", 500), ("thrust_jaw", 80), ("shift_jaw", -60),
-                      ("close_t_l_eyelid", 1000), ("close_t_r_eyelid", 700),
-                      ("close_b_l_eyelid", 300), ("yaw_l_eyeball", 20000),
-                      ("pitch_r_eyeball", -15000), ("thrust_l_eyeball", 100),
-                      ("head_pitch", 20000), ("head_yaw", -30000), ("head_roll", 12000),
-                      ("raise_l_i_eyebrow", 200), ("stretch_l_cornerlip", 150)):
-        values[:, fap(name).index] = amp * np.sin(np.pi * t)
-    mask = np.ones((n, 84), bool)
-    viseme = np.tile([10, 1, 40, 0], (n, 1))
-    expression = np.tile([1, 50, 0, 0, 0, 0], (n, 1))
-    return FapStream(25, values, mask, viseme, expression)
 
 
 @pytest.fixture(scope="module")

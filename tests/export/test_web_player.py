@@ -9,12 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from gltf_eval import busy_stream
 
 from facelib.engine import default_face
 from facelib.export.web import WEB_DIR, export_html
-from facelib.mpeg4 import fap
-
-from test_gltf import busy_stream
 
 pytestmark = [pytest.mark.browser, pytest.mark.render]
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
