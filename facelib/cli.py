@@ -10,6 +10,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 import facelib
 from facelib.errors import FacelibError
 from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
@@ -116,6 +118,49 @@ def _align(args: argparse.Namespace) -> int:
     return 0
 
 
+def _export(args: argparse.Namespace) -> int:
+    from facelib import export
+
+    if args.output is None and args.html is None:
+        raise FacelibError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
+                           "or both")
+    face = _face(args.face)
+    source = _animation(args.source, args.seed)
+    if args.output is not None:
+        suffix = Path(args.output).suffix.lower()
+        if args.arkit or suffix in (".csv", ".json"):
+            curves = export.export_arkit(source, args.output, face=face)
+            moving = curves.relative[curves.relative > 0]
+            fit = (f"; fit residual RMS {1000 * float(curves.residual.mean()):.2f} mm, "
+                   f"median relative {float(np.median(moving)):.2f}" if moving.size else "")
+            print(f"wrote {args.output} ({curves.n_frames} frames of 52 ARKit weights{fit})")
+        else:
+            result = export.export_gltf(source, args.output, face=face, audio=args.audio)
+            audio = f", audio {result.audio}" if result.audio else ""
+            print(f"wrote {result.path} ({len(result.targets)} morph targets, "
+                  f"{result.n_frames} frames{audio})")
+    if args.html is not None:
+        page = export.export_html(source, args.html, face=face, audio=args.audio)
+        print(f"wrote {page.page} (open it in a browser)")
+    return 0
+
+
+def _import_arkit(args: argparse.Namespace) -> int:
+    from facelib.export import import_arkit
+
+    stream = import_arkit(args.capture, fps=args.fps)
+    if args.resample is not None:
+        stream = stream.resample(args.resample)
+    _write_fap(stream, args.output, args.dialect)
+    return 0
+
+
+def _face(path: str | None) -> Any:
+    from facelib.engine import default_face, load_face
+
+    return default_face() if path is None else load_face(path)
+
+
 def _add_render_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("-o", "--output", required=True,
                          help="OUT.mp4, OUT.gif, or a folder for PNG frames")
@@ -183,7 +228,34 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("-o", "--output", required=True, help="OUT.json, OUT.tsv or OUT.sb")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.set_defaults(run=_align)
+    _add_export_commands(commands)
     return parser
+
+
+def _add_export_commands(commands: Any) -> None:
+    export = commands.add_parser(
+        "export", help="export to glTF (.glb), ARKit curves (.csv/.json) or a web page")
+    export.add_argument("source", help="STORY.fdl or FILE.fap")
+    export.add_argument("-o", "--output",
+                        help="OUT.glb (glTF), or with --arkit OUT.csv (Live Link Face) / OUT.json")
+    export.add_argument("--arkit", action="store_true",
+                        help="write ARKit-52 blendshape curves instead of glTF")
+    export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
+    export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
+    export.add_argument("--seed", type=int)
+    export.set_defaults(run=_export)
+
+    imp = commands.add_parser("import-arkit",
+                              help="turn an ARKit capture (Live Link Face CSV) into a .fap")
+    imp.add_argument("capture", help="the Live Link Face .csv (or facelib's ARKit .json)")
+    imp.add_argument("-o", "--output", required=True, help="OUT.fap")
+    imp.add_argument("--fps", type=float,
+                     help="timecode rate of the capture (default: read from the timecodes)")
+    imp.add_argument("--resample", type=float, help="resample to this frame rate (e.g. 25)")
+    imp.add_argument("--dialect", default="standard",
+                     choices=("standard", "xface", "greta", "extended"))
+    imp.set_defaults(run=_import_arkit)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
