@@ -161,6 +161,19 @@ def _face(path: str | None) -> Any:
     return default_face() if path is None else load_face(path)
 
 
+def _evaluate(args: argparse.Namespace) -> int:
+    from facelib.evaluate import DEFORMERS, evaluate_deformers, evaluation_poses, write_evaluation
+
+    names = tuple(n.strip() for n in args.deformers.split(",")) if args.deformers else DEFORMERS
+    kinds = tuple(k.strip() for k in args.poses.split(","))
+    ev = evaluate_deformers(names, group=args.region, poses=evaluation_poses(kinds),
+                            face_path=args.face)
+    for path in write_evaluation(ev, args.output, sheet=not args.no_sheet, stem=args.stem,
+                                 face_path=args.face):
+        print(f"wrote {path}")
+    return 0
+
+
 def _add_render_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("-o", "--output", required=True,
                          help="OUT.mp4, OUT.gif, or a folder for PNG frames")
@@ -229,6 +242,18 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.set_defaults(run=_align)
     _add_export_commands(commands)
+
+    evaluate = commands.add_parser(
+        "evaluate", help="compare deformers by lip roughness (CSV, Markdown, contact sheet)")
+    evaluate.add_argument("-o", "--output", required=True, help="folder for the results")
+    evaluate.add_argument("--deformers", help="comma-separated names (default: all seven)")
+    evaluate.add_argument("--region", default="lips", help="region or group to switch")
+    evaluate.add_argument("--poses", default="viseme,expression,syllable",
+                          help="comma-separated pose kinds: viseme, expression, syllable")
+    evaluate.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    evaluate.add_argument("--stem", default="deformers", help="file name stem")
+    evaluate.add_argument("--no-sheet", action="store_true", help="skip the mouth contact sheet")
+    evaluate.set_defaults(run=_evaluate)
     return parser
 
 
