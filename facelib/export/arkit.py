@@ -109,12 +109,13 @@ def _load_targets(face: Face) -> tuple[np.ndarray, np.ndarray]:
         raise FaceModelError("ARKit curves need the default head (its ARKit targets come from "
                              "the same base mesh); this face has other vertices")
     ids = np.unique(raw["vertices"])
-    at = np.searchsorted(ids, raw["vertices"])
+    at = np.asarray(np.searchsorted(ids, np.asarray(raw["vertices"])), np.int64)
     targets = np.zeros((len(ids), 3, len(names)))
-    offsets = raw["offsets"]
+    offsets = [int(o) for o in raw["offsets"]]
+    shifts = np.asarray(raw["displacements"], np.float64)
     for k in range(len(names)):
         part = slice(offsets[k], offsets[k + 1])
-        targets[at[part], :, k] = raw["displacements"][part].astype(np.float64)
+        targets[at[part], :, k] = shifts[part]
     return ids, targets.reshape(-1, len(names))
 
 
