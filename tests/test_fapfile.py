@@ -77,6 +77,7 @@ def test_written_standard_file_is_the_plain_profile(tmp_path):
     assert not back.mask[:, 68:].any()
 
 
+@pytest.mark.filterwarnings("ignore::facelib.errors.FacelibWarning")
 def test_xface_and_extended_dialects_keep_high_level_and_extended(tmp_path):
     values = np.zeros((3, 84), np.float32)
     values[:, 76] = [1, 2, 3]
