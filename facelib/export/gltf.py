@@ -186,7 +186,6 @@ def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: P
     """One keyframe per frame: morph weights and every joint transform that changes."""
     lib = b.lib
     n = len(weights)
-    times = b.accessor((np.arange(n) / fps).astype(np.float32), "SCALAR", bounds=True)
     channels: list[tuple[int, str, np.ndarray, str]] = []
     if weights.size:
         channels.append((mesh_node, "weights", weights.reshape(-1, 1), "SCALAR"))
@@ -197,6 +196,7 @@ def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: P
                 channels.append((node, path, values, kind))
     if not channels or n < 1:
         return
+    times = b.accessor((np.arange(n) / fps).astype(np.float32), "SCALAR", bounds=True)
     animation = lib.Animation(name="facelib", samplers=[], channels=[])
     for node, path, values, kind in channels:
         animation.samplers.append(lib.AnimationSampler(

@@ -27,6 +27,8 @@ def resolve_source(
     if not isinstance(stream, FapStream):
         raise ParameterError(f"export needs a FapStream or an animation with .faps, not "
                              f"{type(source).__name__}")
+    if stream.n_frames == 0:
+        raise ParameterError("nothing to export: the stream has no frames")
     own = getattr(source, "audio", None)
     offset = float(getattr(source, "audio_offset", 0.0) or 0.0)
     chosen = Path(audio) if audio is not None else (Path(own) if own is not None else None)

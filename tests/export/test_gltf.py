@@ -69,3 +69,23 @@ def test_gltf_validator_reports_no_issue(exported):
                          capture_output=True, text=True, check=False)
     report = json.loads(run.stdout)
     assert report["numErrors"] == 0 and report["numWarnings"] == 0, report["messages"][:5]
+
+
+def test_still_and_empty_streams(tmp_path):
+    from facelib import FapStream, ParameterError
+
+    result = export_gltf(FapStream.zeros(3, fps=25), tmp_path / "still.glb")
+    g = Gltf(result.path).g
+    assert result.targets == () and g.animations == [] and len(g.skins) == 1
+    with pytest.raises(ParameterError, match="no frames"):
+        export_gltf(FapStream.zeros(0, fps=25), tmp_path / "empty.glb")
+    with pytest.raises(ParameterError, match=r"\.glb"):
+        export_gltf(FapStream.zeros(3, fps=25), tmp_path / "x.gltf")
+
+
+def test_exports_are_lazy_names_of_facelib():
+    import facelib
+    import facelib.export as ex
+
+    assert facelib.export_gltf is ex.export_gltf and facelib.import_arkit is ex.import_arkit
+    assert {"export_gltf", "export_html", "export_arkit", "import_arkit"} <= set(facelib.__all__)
