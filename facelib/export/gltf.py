@@ -28,6 +28,7 @@ __all__ = ["GltfExport", "export_gltf"]
 
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
 _ARRAY, _ELEMENTS = 34962, 34963
+_NORMAL_EPS = 1e-4  # normal changes below this are not stored
 
 
 @dataclass(frozen=True)
@@ -76,8 +77,10 @@ class _Builder:
             type=kind, **extra))
         return len(self.g.accessors) - 1
 
-    def sparse_target(self, count: int, ids: np.ndarray, values: np.ndarray) -> int:
-        """A VEC3 float accessor of ``count`` zeros with ``values`` at ``ids`` (sorted)."""
+    def sparse_target(self, count: int, ids: np.ndarray, values: np.ndarray, *,
+                      bounds: bool = True) -> int:
+        """A VEC3 float accessor of ``count`` zeros with ``values`` at ``ids`` (sorted);
+        ``bounds``: write min/max (required for POSITION targets)."""
         lib = self.lib
         sparse = None
         lo, hi = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
@@ -91,9 +94,10 @@ class _Builder:
                 values=lib.AccessorSparseValues(bufferView=self.view(values.astype(np.float32))))
             lo = np.minimum(values.min(0), 0).tolist()
             hi = np.maximum(values.max(0), 0).tolist()
+        extra = {"min": lo, "max": hi} if bounds else {}
         self.g.accessors.append(lib.Accessor(
             byteOffset=None, componentType=_FLOAT, count=count, type="VEC3", sparse=sparse,
-            min=lo, max=hi))
+            **extra))
         return len(self.g.accessors) - 1
 
     def blob(self) -> bytes:
@@ -131,6 +135,9 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     lib = b.lib
     look = data.json_data("render_look.json")["parts"]
     normals = vertex_normals(face.vertices, face.triangles)
+    # each target's change of the normals, so that players shade the deformed face right
+    normal_turns = [vertex_normals(face.vertices + disp, face.triangles) - normals
+                    for disp in targets]
     colours = _srgb_to_linear(face.vertex_colors)
     joints = np.zeros((face.n_vertices, 4), np.uint16)
     joints[:, :2] = rig.joints
@@ -149,9 +156,12 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
             JOINTS_0=b.accessor(joints[ids], "VEC4", target=_ARRAY),
             WEIGHTS_0=b.accessor(weights[ids], "VEC4", target=_ARRAY))
         morph = []
-        for disp in targets:
+        for disp, turn in zip(targets, normal_turns, strict=True):
             moved = np.flatnonzero(np.any(disp[ids] != 0, axis=1))
-            morph.append({"POSITION": b.sparse_target(len(ids), moved, disp[ids][moved])})
+            turned = np.flatnonzero(np.any(np.abs(turn[ids]) > _NORMAL_EPS, axis=1))
+            morph.append({"POSITION": b.sparse_target(len(ids), moved, disp[ids][moved]),
+                          "NORMAL": b.sparse_target(len(ids), turned, turn[ids][turned],
+                                                    bounds=False)})
         material = look.get(name, look["default"])
         b.g.materials.append(lib.Material(
             name=name, doubleSided=True, pbrMetallicRoughness=lib.PbrMetallicRoughness(

@@ -47,7 +47,12 @@ def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
     names = g.meshes[0].extras["targetNames"]
     assert len(names) == len(result.targets) == len(g.meshes[0].primitives[0].targets)
     assert all(g.accessors[t["POSITION"]].bufferView is None
+               and g.accessors[t["NORMAL"]].bufferView is None
                for p in g.meshes[0].primitives for t in p.targets)
+    skin = g.meshes[0].primitives[0]
+    moved = [g.accessors[t["POSITION"]].sparse for t in skin.targets]
+    assert all(s is not None and 0 < s.count < 0.5 * g.accessors[skin.attributes.POSITION].count
+               for s in moved)  # sparse: each target moves a part of the skin
     assert [p.material for p in g.meshes[0].primitives] == list(range(6))
     extras = g.asset.extras["facelib"]
     assert extras["n_frames"] == 12 and extras["fps"] == 25
