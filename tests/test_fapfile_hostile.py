@@ -13,6 +13,8 @@ import pytest
 from facelib.errors import FacelibWarning, FapFormatError, ParameterError
 from facelib.mpeg4 import FapStream, read_fap, write_fap
 
+pytestmark = pytest.mark.usefixtures("memory_cap")
+
 MASK = " ".join(["0", "0", "1"] + ["0"] * 65)
 
 

@@ -239,6 +239,10 @@ def _error(
         where = int(m.group("line"))
         message = m.group("msg")
     message = one_line(message)
+    if kind == "syntax" and "too many registers" in message:
+        return FdlError("tables or expressions nested too deeply for the sandbox (it marks "
+                        "every table with its line; about 80 levels fit)", path=path,
+                        line=where)
     if kind == "syntax":
         return FdlError(f"syntax error: {message}", path=path, line=where)
     g = _GLOBAL.search(message)

@@ -13,6 +13,8 @@ from facelib import fdl
 from facelib.errors import FdlError, ParameterError, SpeechError
 from facelib.fdl.sandbox import Sandbox
 
+pytestmark = pytest.mark.usefixtures("memory_cap")
+
 C_WORK = {
     "rep_in_a_loop": 'while true do local s = string.rep("x", 4 * 1024 * 1024) end',
     "gsub_of_10_mb": 'local s = string.rep("a", 10 * 1024 * 1024) while true do '
@@ -118,3 +120,10 @@ def test_text_only_speech_length_is_bounded() -> None:
     with pytest.raises(SpeechError, match="more than 100000") as info:
         facelib.animate(board)
     assert info.value.line == 1
+
+
+def test_deep_nesting_has_a_clear_message() -> None:
+    fdl.loads("x = " + "{" * 80 + "}" * 80)
+    with pytest.raises(FdlError, match="nested too deeply") as info:
+        fdl.loads("\nx = " + "{" * 150 + "}" * 150, name="story.fdl")
+    assert info.value.line == 2
