@@ -14,7 +14,7 @@ from gltf_eval import busy_stream
 from facelib.engine import default_face
 from facelib.export.web import WEB_DIR, export_html
 
-pytestmark = [pytest.mark.browser, pytest.mark.render]
+pytestmark = [pytest.mark.browser, pytest.mark.render, pytest.mark.slow]
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 GREEN = (0.0, 1.0, 0.0)
 
