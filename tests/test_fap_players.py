@@ -91,3 +91,17 @@ def test_a_file_with_only_fap_1_and_2_animates_the_face():
     plain = FapStream(stream.fps, stream.values, stream.mask & ~np.eye(84, dtype=bool)[0:1]
                       & ~np.eye(84, dtype=bool)[1:2])
     assert np.abs(moved - (face.deform(plain) - face.vertices)).max() > 1e-3  # > 1 mm
+
+
+def test_warnings_for_greta_frame_rate_and_long_high_level_files(tmp_path):
+    with pytest.warns(FacelibWarning, match="plays 25 fps"):
+        write_fap(FapStream.zeros(3, fps=30), tmp_path / "g30.fap", dialect="greta")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_fap(FapStream.zeros(3, fps=25), tmp_path / "g25.fap", dialect="greta")
+    n = 8001
+    mask = np.zeros((n, 84), bool)
+    mask[:, 0] = True
+    long = FapStream(25, np.zeros((n, 84), np.float32), mask, np.tile([1, 2, 30, 0], (n, 1)))
+    with pytest.warns(FacelibWarning, match="8000 frames"):
+        write_fap(long, tmp_path / "long.fap", dialect="extended")

@@ -56,6 +56,8 @@ __all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _WRITE_DIALECTS = ("standard", "xface", "greta", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
+_GRETA_FPS = 25  # Greta's Java reader: Constants.FRAME_PER_SECOND (fap_players.md M10)
+_GRETA_CPP_FRAMES = 8000  # Greta's C++ reader: fap1[8000][4], fap2[8000][6] (M8)
 _GROUP = {0: len(VISEME_FIELDS), 1: len(EXPRESSION_FIELDS)}
 _FIELD_LIMITS = {0: VISEME_LIMITS, 1: EXPRESSION_LIMITS}
 VALUE_LIMIT = 2**31 - 1
@@ -388,7 +390,9 @@ def write_fap(
         shift every later value), ``"greta"`` (69 mask tokens, the 69th always 0, as Greta
         writes) or ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2;
         only facelib reads it). Every dialect but ``extended`` warns, naming them, when it
-        drops extended FAPs 69-84 that carry values.
+        drops extended FAPs 69-84 that carry values; ``greta`` warns unless the stream has
+        25 fps (Greta plays every file at 25), ``xface`` and ``extended`` when over 8000
+        frames carry FAP 1/2 (Greta's C++ reader crashes).
     name:
         The header's name; default: the file's stem. Spaces become underscores.
 
@@ -447,8 +451,19 @@ def _warn_dropped(stream: FapStream, path: Path, dialect: str) -> None:
                 f"{path}: the {dialect} dialect has no extended FAPs; dropping FAP "
                 f"{', '.join(map(str, dropped))} (write dialect='extended' to keep them; "
                 "only facelib reads that dialect)", FacelibWarning, stacklevel=3)
-    if dialect == "xface" and stream.mask[:, :2].any() and (
-            stream.viseme is not None or stream.expression is not None):
+    if dialect == "greta" and stream.fps != _GRETA_FPS:
+        warnings.warn(
+            f"{path}: Greta's Java reader ignores the header's frame rate and plays "
+            f"{_GRETA_FPS} fps; this stream has {stream.fps:g} fps (resample it: "
+            f"stream.resample({_GRETA_FPS}))", FacelibWarning, stacklevel=3)
+    high_level = stream.mask[:, :2].any() and (
+        stream.viseme is not None or stream.expression is not None)
+    if high_level and dialect in ("xface", "extended") and stream.n_frames > _GRETA_CPP_FRAMES:
+        warnings.warn(
+            f"{path}: {stream.n_frames} frames with FAP 1/2: Greta's C++ reader keeps them in "
+            f"arrays of {_GRETA_CPP_FRAMES} frames and crashes on longer files",
+            FacelibWarning, stacklevel=3)
+    if dialect == "xface" and high_level:
         warnings.warn(
             f"{path}: the xface dialect writes FAP 1/2 as 4- and 6-token groups, which Greta's "
             "Java reader and VREng read as one token each, shifting every later value of "
