@@ -38,11 +38,14 @@ _LAZY = {
     "save_png": "facelib.rendering.frames",
     "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
+    "setup_face": "facelib.engine.setup",
+    "write_face": "facelib.engine.writer",
 }
 
 
 def __getattr__(name: str) -> Any:
-    """Rendering, the viewer and plotting import OpenGL or matplotlib: load them on use."""
+    """Rendering, the viewer, plotting and face set-up import OpenGL, matplotlib or trimesh:
+    load them on use."""
     if name in _LAZY:
         import importlib
 
@@ -79,8 +82,10 @@ __all__ = [
     "render_still",
     "run_fdl",
     "save_png",
+    "setup_face",
     "sync",
     "view",
     "visemes",
+    "write_face",
     "write_fap",
 ]

@@ -10,9 +10,12 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 import facelib
 from facelib.errors import FacelibError
 from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4.tables import FAPU_SCALE
 
 __all__ = ["main"]
 
@@ -75,25 +78,63 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _face_path(face: str | None) -> Path | None:
+    """``--face``: a face definition JSON, or the folder ``facelib face setup`` wrote."""
+    if face is None:
+        return None
+    path = Path(face)
+    return path / "face.json" if path.is_dir() else path
+
+
 def _render(args: argparse.Namespace) -> int:
-    from facelib.engine import load_face
     from facelib.rendering.frames import render
 
     started = time.perf_counter()
     source = _animation(args.source, args.seed)
     if args.fap is not None:
         _write_fap(source if isinstance(source, FapStream) else source.faps, args.fap, "standard")
-    out = render(source, face=load_face(args.face), out=args.output, width=args.width,
+    out = render(source, face=_face_path(args.face), out=args.output, width=args.width,
                  height=args.height, audio=args.audio, fps=args.fps)
     print(f"wrote {out} in {time.perf_counter() - started:.1f} s")
     return 0
 
 
 def _view(args: argparse.Namespace) -> int:
-    from facelib.engine import load_face
     from facelib.rendering.viewer import view
 
-    view(_animation(args.source, args.seed), face=load_face(args.face), loop=args.loop)
+    view(_animation(args.source, args.seed), face=_face_path(args.face), loop=args.loop)
+    return 0
+
+
+def _face_setup(args: argparse.Namespace) -> int:
+    from facelib.engine.headmesh import load_head_mesh
+    from facelib.engine.setup import set_up_face
+    from facelib.engine.writer import write_face
+
+    if args.landmarks is None:
+        raise FacelibError("give the landmarks with --landmarks L.json (see docs/own-head.md)")
+    bad = [item for item in args.part if "=" not in item]
+    if bad:
+        raise FacelibError(f"--part {bad[0]!r} must be PART=OBJECT, e.g. eye_l=LeftEye")
+    started = time.perf_counter()
+    parts = dict(item.split("=", 1) for item in args.part)
+    mesh = load_head_mesh(args.mesh, parts=parts)
+    result = set_up_face(mesh, landmarks=args.landmarks, unit=args.unit)
+    out = write_face(result.face, Path(args.output) / "face.json", name=Path(args.mesh).stem,
+                     source=f"facelib face setup {Path(args.mesh).name}")
+    face = result.face
+    print(f"mesh:      {args.mesh} ({len(mesh.vertices)} vertices, unit {result.unit})")
+    if not np.allclose(result.rotation, np.eye(3)):
+        print("oriented:  turned upright (+y up, looking along +z)")
+    print(f"landmarks: {len(result.landmarks)}, off the surface by at most "
+          f"{result.residual.max() * 1000:.2f} mm")
+    own = [p for p in face.parts if p not in result.carried]
+    print(f"parts:     {', '.join(own)} from the mesh"
+          + (f"; {', '.join(result.carried)} warped into place from the default head"
+             if result.carried else ""))
+    print("FAPU0 (mm): " + "  ".join(f"{k} {v * FAPU_SCALE * 1000:.2f}"
+                                      for k, v in face.fapu.items() if k != "AU"))
+    print(f"wrote {out} in {time.perf_counter() - started:.1f} s")
     return 0
 
 
@@ -119,7 +160,8 @@ def _align(args: argparse.Namespace) -> int:
 def _add_render_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("-o", "--output", required=True,
                          help="OUT.mp4, OUT.gif, or a folder for PNG frames")
-    command.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    command.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
+                         "folder (default: the storyboard's face, else the bundled head)")
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)
     command.add_argument("--fps", type=float, help="resample to this frame rate")
@@ -169,6 +211,20 @@ def _build_parser() -> argparse.ArgumentParser:
     view.add_argument("--loop", action="store_true")
     view.add_argument("--seed", type=int)
     view.set_defaults(run=_view)
+
+    face = commands.add_parser("face", help="make your own head mesh animatable")
+    face_commands = face.add_subparsers(dest="face_command", metavar="ACTION")
+    setup = face_commands.add_parser(
+        "setup", help="transfer the default face definition onto a head mesh")
+    setup.add_argument("mesh", help="head mesh: .obj, .ply, .glb/.gltf, .off or .stl")
+    setup.add_argument("--landmarks", help="JSON of feature point -> vertex index or [x, y, z]")
+    setup.add_argument("-o", "--output", required=True, help="folder for face.json + face.npz")
+    setup.add_argument("--unit", choices=("m", "dm", "cm", "mm", "in"),
+                       help="the mesh's length unit (default: guessed from the landmarks)")
+    setup.add_argument("--part", action="append", default=[], metavar="PART=OBJECT",
+                       help="name the file's object for a part (eye_l, eye_r, teeth_upper, "
+                            "teeth_lower, tongue), e.g. --part eye_l=LeftEye")
+    setup.set_defaults(run=_face_setup)
 
     plot = commands.add_parser("plot", help="plot FAP curves of a storyboard or .fap")
     plot.add_argument("source", help="STORY.fdl or FILE.fap")

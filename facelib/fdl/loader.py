@@ -3,7 +3,8 @@
 One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts, or the
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
-``fps`` (default 25), ``seed`` (default 0) and ``output`` set the storyboard options.
+``fps`` (default 25), ``seed`` (default 0), ``output`` and ``face`` (a face definition
+JSON, e.g. one made by ``facelib face setup``) set the storyboard options.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ __all__ = ["load", "loads"]
 log = logging.getLogger("facelib.fdl")
 
 DEFAULT_FPS = 25.0
-SETTINGS = ("fps", "seed", "output", "FDL", "expressions", "eyes", "Sentence")
+SETTINGS = ("fps", "seed", "output", "face", "FDL", "expressions", "eyes", "Sentence")
 """Globals a storyboard may set (besides its own helpers and variables)."""
 _MAX_FPS = 1000.0
 
@@ -225,6 +226,9 @@ def _build(
             base_dir, output_value, what="output", path=name, line=output_line, must_exist=False
         )
     )
+    face_value = _global(chunk, "face")
+    face = (None if face_value is None else resolve_inside(
+        base_dir, face_value, what="face", path=name, line=_line(text, "face")))
     return Storyboard(
         path=file,
         fps=float(fps),
@@ -236,6 +240,7 @@ def _build(
         gaze_defs=parts.gaze_defs,
         output=output,
         expression_mixes=parts.expression_mixes,
+        face=face,
     )
 
 

@@ -59,7 +59,7 @@ def view(
             f"{os.environ['PYOPENGL_PLATFORM']!r}); open the viewer in a fresh process"
         )
     stream, _, _ = stream_of(source)
-    face = face_or_default(face)
+    face = face_or_default(face, source)
     pr = import_pyrender(offscreen=False)
     scene = FaceRenderer(face, width=width, height=height, mesh_update="swap", offscreen=False)
     try:
