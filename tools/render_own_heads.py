@@ -56,7 +56,7 @@ def main(folder: str) -> None:
         heads[name] = (result.face, result)
     animation = run_fdl(ROOT / "examples" / "hello" / "hello.fdl")
     stream = animation.faps
-    frames = [min(int(round(t * stream.fps)), stream.n_frames - 1) for t in MOMENTS]
+    frames = [min(round(t * stream.fps), stream.n_frames - 1) for t in MOMENTS]
     rows, marks = [], []
     for name, (face, result) in heads.items():
         with FaceRenderer(face, width=260, height=300) as renderer:
