@@ -9,6 +9,7 @@ that a point on the upper lip is not matched to the lower lip 0.2 mm away.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,19 +53,21 @@ class Surface:
     """A triangle mesh prepared for closest-point queries.
 
     vertices: (V, 3) float64. triangles: (F, 3) int64. normals: (F, 3) float64 unit.
-    tree: cKDTree over sample points of the triangles (corners and a grid on the large
-        ones); owner: (S,) int64 the triangle of each sample; radius: every point of a
-        triangle lies within this distance of one of its samples; extent: the bounding-box
-        diagonal (no search goes farther).
+    tree: cKDTree over S sample points (the vertices, and a grid on large triangles).
+    indptr: (S + 1,) int64 and triangle_of: int64, the triangles of each sample (CSR).
+    radius: every point of a triangle is within this distance of one of its samples.
+    centroids: (F, 3) float64; sizes: (F,) float64 largest centroid-to-corner distances.
     """
 
     vertices: np.ndarray
     triangles: np.ndarray
     normals: np.ndarray
     tree: cKDTree
-    owner: np.ndarray
+    indptr: np.ndarray
+    triangle_of: np.ndarray
     radius: float
-    extent: float
+    centroids: np.ndarray
+    sizes: np.ndarray
 
     @property
     def corners(self) -> np.ndarray:
@@ -94,7 +97,12 @@ class SurfacePoints:
 
 
 def surface(vertices: np.ndarray, triangles: np.ndarray) -> Surface:
-    """Prepare ``vertices (V, 3)``, ``triangles (F, 3)`` for :func:`closest_points`."""
+    """Prepare ``vertices (V, 3)``, ``triangles (F, 3)`` for :func:`closest_points`.
+
+    Samples are the vertices plus, on triangles longer than half the median edge, a
+    barycentric grid fine enough that every point of a triangle is within ``radius`` of
+    one of its own samples.
+    """
     v = np.asarray(vertices, dtype=np.float64)
     t = np.asarray(triangles, dtype=np.int64)
     if not len(t):
@@ -103,18 +111,29 @@ def surface(vertices: np.ndarray, triangles: np.ndarray) -> Surface:
     longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
     spacing = max(float(np.median(longest)) / 2, 1e-12)
     steps = np.clip(np.ceil(longest / spacing), 1, 64).astype(np.int64)
-    samples, owner = [], []
-    for n in np.unique(steps):
+    # sample -> triangles (CSR): each vertex to the triangles around it, grid points to theirs
+    owner_rows = [np.repeat(t.ravel(), 1)]
+    owner_tris = [np.repeat(np.arange(len(t)), 3)]
+    samples = [v]
+    count = len(v)
+    for n in np.unique(steps[steps > 1]):
         which = np.flatnonzero(steps == n)
         i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = i + j <= n
+        keep = (i + j <= n) & ~((i == n) | (j == n) | (i + j == 0))
         bary = np.stack([i[keep], j[keep], n - i[keep] - j[keep]], axis=1) / n  # (G, 3)
-        samples.append(np.einsum("gk,fkc->fgc", bary, corners[which]).reshape(-1, 3))
-        owner.append(np.repeat(which, len(bary)))
+        grid = np.einsum("gk,fkc->fgc", bary, corners[which]).reshape(-1, 3)
+        samples.append(grid)
+        owner_rows.append(count + np.arange(len(grid)))
+        owner_tris.append(np.repeat(which, len(bary)))
+        count += len(grid)
+    rows, tris = np.concatenate(owner_rows), np.concatenate(owner_tris)
+    order = np.argsort(rows, kind="stable")
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=count))])
     radius = float((longest / steps).max())
-    extent = float(np.linalg.norm(np.ptp(v[np.unique(t)], axis=0)))
+    centroids = corners.mean(axis=1)
+    sizes = np.linalg.norm(corners - centroids[:, None], axis=2).max(axis=1)
     return Surface(v, t, triangle_normals(v, t), cKDTree(np.concatenate(samples)),
-                   np.concatenate(owner), radius, extent)
+                   indptr, tris[order], radius, centroids, sizes)
 
 
 def closest_points(surf: Surface, points: np.ndarray, *, normals: np.ndarray | None = None,
@@ -125,9 +144,10 @@ def closest_points(surf: Surface, points: np.ndarray, *, normals: np.ndarray | N
     another way (``dot < min_cos``) are skipped, and a query that no triangle passes falls
     back to the unchecked closest point.
 
-    Every triangle within distance ``d`` of a query owns a sample within ``d + radius``;
-    ``d`` starts at the distance to the nearest sample (a point of the surface) and grows
-    to the best admissible distance found, so the search is exact.
+    A triangle within distance ``d`` of a query has one of its samples within
+    ``d + radius``. ``d`` starts at the distance of the nearest sample (a point of the
+    surface, so no closer than the answer) and grows to the best admissible distance found
+    when that is farther, so the search is exact.
     """
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     m = len(pts)
@@ -135,26 +155,21 @@ def closest_points(surf: Surface, points: np.ndarray, *, normals: np.ndarray | N
     best_t = np.zeros(m, np.int64)
     best_p = np.zeros((m, 3))
     reach, _ = surf.tree.query(pts)
-    searched = np.zeros(m)
+    limit = reach.max() + 2 * float(np.linalg.norm(np.ptp(surf.vertices, axis=0)))
     todo = np.arange(m)
     while todo.size:
-        radius = reach[todo] + surf.radius
-        cand_q, cand_t = _ball_pairs(surf, pts[todo], radius)
-        q = todo[cand_q]
-        found_p = closest_on_triangles(surf.corners[cand_t], pts[q])
+        row, tri = _candidates(surf, pts[todo], reach[todo] + surf.radius)
+        q = todo[row]
+        found_p = closest_on_triangles(surf.corners[tri], pts[q])
         found_d = np.linalg.norm(found_p - pts[q], axis=1)
         if normals is not None:
-            ok = _dot(surf.normals[cand_t], normals[q]) >= min_cos
+            ok = _dot(surf.normals[tri], normals[q]) >= min_cos
             found_d = np.where(ok, found_d, np.inf)
         order = np.lexsort((found_d, q))
         first = order[np.r_[True, q[order][1:] != q[order][:-1]]]
-        better = found_d[first] < best_d[q[first]]
-        win = first[better]
-        best_d[q[win]], best_t[q[win]], best_p[q[win]] = found_d[win], cand_t[win], found_p[win]
-        searched[todo] = reach[todo]
-        # exact once the best admissible point is within the distance searched
-        grow = todo[best_d[todo] > searched[todo]]
-        grow = grow[reach[grow] < surf.extent]
+        win = first[found_d[first] < best_d[q[first]]]
+        best_d[q[win]], best_t[q[win]], best_p[q[win]] = found_d[win], tri[win], found_p[win]
+        grow = todo[(best_d[todo] > reach[todo]) & (reach[todo] < limit)]
         reach[grow] = np.where(np.isfinite(best_d[grow]), best_d[grow],
                                2 * reach[grow] + surf.radius)
         todo = grow
@@ -167,15 +182,24 @@ def closest_points(surf: Surface, points: np.ndarray, *, normals: np.ndarray | N
     return SurfacePoints(best_p, best_t, bary, best_d)
 
 
-def _ball_pairs(surf: Surface, pts: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray,
-                                                                           np.ndarray]:
-    """Unique (query row, triangle) pairs with a sample of the triangle within ``radius``."""
+def _candidates(surf: Surface, pts: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray,
+                                                                          np.ndarray]:
+    """(query row, triangle) pairs: the triangles of every sample within ``radius``."""
     hits = surf.tree.query_ball_point(pts, radius, return_sorted=False)
-    counts = np.fromiter((len(h) for h in hits), np.int64, len(hits))
-    rows = np.repeat(np.arange(len(pts)), counts)
-    tris = surf.owner[np.fromiter((i for h in hits for i in h), np.int64, int(counts.sum()))]
-    pairs = np.unique(rows * len(surf.triangles) + tris)
-    return pairs // len(surf.triangles), pairs % len(surf.triangles)
+    per_row = np.fromiter(map(len, hits), np.int64, len(hits))
+    samples = np.fromiter(itertools.chain.from_iterable(hits), np.int64, int(per_row.sum()))
+    starts = surf.indptr[samples]
+    counts = surf.indptr[samples + 1] - starts
+    rows = np.repeat(np.repeat(np.arange(len(hits)), per_row), counts)
+    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    tris = surf.triangle_of[offsets + np.arange(int(counts.sum()))]
+    n_tri = len(surf.triangles)
+    pairs = np.unique(rows * n_tri + tris)  # a triangle is found through each corner
+    rows, tris = pairs // n_tri, pairs % n_tri
+    # no point of a triangle is nearer than its centroid's distance minus its size
+    gap = np.linalg.norm(pts[rows] - surf.centroids[tris], axis=1) - surf.sizes[tris]
+    keep = gap <= radius[rows] - surf.radius
+    return rows[keep], tris[keep]
 
 
 def closest_on_triangles(corners: np.ndarray, points: np.ndarray) -> np.ndarray:
