@@ -106,22 +106,46 @@ def _view(args: argparse.Namespace) -> int:
     return 0
 
 
+def _write_found(found: Any, folder: Path) -> None:
+    """The automatic landmarks as an editable JSON and a picture of where they are."""
+    import json
+
+    from facelib.atomic import write_text_atomic
+    from facelib.rendering.video import save_png
+    from facelib.tracking.head_landmarks import draw_landmarks
+
+    write_text_atomic(folder / "landmarks.json",
+                      json.dumps({"landmarks": found.as_json()}, indent=1) + "\n")
+    save_png(draw_landmarks(found), folder / "landmarks.png")
+    print(f"found:     {len(found.points)} feature points (see {folder / 'landmarks.png'}; "
+          f"edit {folder / 'landmarks.json'} and rerun with --landmarks to correct them)")
+
+
 def _face_setup(args: argparse.Namespace) -> int:
     from facelib.engine.headmesh import load_head_mesh
     from facelib.engine.setup import set_up_face
     from facelib.engine.writer import write_face
 
-    if args.landmarks is None:
-        raise FacelibError("give the landmarks with --landmarks L.json (see docs/own-head.md)")
+    if (args.landmarks is None) == (not args.auto):
+        raise FacelibError("give either --landmarks L.json or --auto (see docs/own-head.md)")
     bad = [item for item in args.part if "=" not in item]
     if bad:
         raise FacelibError(f"--part {bad[0]!r} must be PART=OBJECT, e.g. eye_l=LeftEye")
     started = time.perf_counter()
     parts = dict(item.split("=", 1) for item in args.part)
     mesh = load_head_mesh(args.mesh, parts=parts)
-    result = set_up_face(mesh, landmarks=args.landmarks, unit=args.unit)
+    landmarks: Any = args.landmarks
+    found = None
+    if args.auto:
+        from facelib.tracking.head_landmarks import detect_head_landmarks
+
+        found = detect_head_landmarks(mesh)
+        landmarks = found.as_json()
+    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit)
     out = write_face(result.face, Path(args.output) / "face.json", name=Path(args.mesh).stem,
                      source=f"facelib face setup {Path(args.mesh).name}")
+    if found is not None:
+        _write_found(found, Path(args.output))
     face = result.face
     print(f"mesh:      {args.mesh} ({len(mesh.vertices)} vertices, unit {result.unit})")
     if not np.allclose(result.rotation, np.eye(3)):
@@ -314,6 +338,9 @@ def _build_parser() -> argparse.ArgumentParser:
         "setup", help="transfer the default face definition onto a head mesh")
     setup.add_argument("mesh", help="head mesh: .obj, .ply, .glb/.gltf, .off or .stl")
     setup.add_argument("--landmarks", help="JSON of feature point -> vertex index or [x, y, z]")
+    setup.add_argument("--auto", action="store_true",
+                       help="find the landmarks automatically (MediaPipe on a front view of "
+                            "the mesh; needs the track and render extras)")
     setup.add_argument("-o", "--output", required=True, help="folder for face.json + face.npz")
     setup.add_argument("--unit", choices=("m", "dm", "cm", "mm", "in"),
                        help="the mesh's length unit (default: guessed from the landmarks)")

@@ -57,7 +57,7 @@ def face_or_default(face: Deformable | str | os.PathLike[str] | None,
         storyboard = getattr(source, "storyboard", None)
         face = getattr(storyboard, "face", None)
     if isinstance(face, (str, os.PathLike)):
-        return load_face(face)
+        return load_face(Path(face))
     return default_face() if face is None else face
 
 

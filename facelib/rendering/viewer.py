@@ -33,7 +33,7 @@ def has_display() -> bool:
 def view(
     source: FapStream | HasFaps,
     *,
-    face: Deformable | None = None,
+    face: Deformable | str | os.PathLike[str] | None = None,
     width: int = 800,
     height: int = 600,
     loop: bool = False,
