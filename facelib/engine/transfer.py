@@ -262,4 +262,5 @@ class _Mapper:
         return Region(name=region.name, deformer=region.deformer,
                       feature_points=region.feature_points, vertices=ids.astype(np.int32),
                       anchors=anchors.astype(np.int32), weights=w.astype(np.float32),
-                      pivot=region.pivot)
+                      pivot=region.pivot, params=region.params, group=region.group,
+                      custom=region.custom)

@@ -44,6 +44,13 @@ def face_document(face: Face, *, mesh: str, name: str, source: str = "") -> dict
             item["weights"] = [round(float(w), 6) for w in r.weights]
         if r.pivot:
             item["pivot"] = r.pivot
+        if r.group:
+            item["group"] = r.group
+        if r.params:
+            item["params"] = dict(r.params)
+        if r.custom is not None:
+            raise FaceModelError(f"region {r.name!r} has a custom deformer object, which a "
+                                 "face definition file cannot hold; register it by name")
         regions.append(item)
     point, normal, blend = face.neck
     return {

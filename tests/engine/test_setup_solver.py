@@ -157,3 +157,15 @@ def test_d2_normal_check_skips_facing_away(face) -> None:  # type: ignore[no-unt
     facing = np.einsum("mc,mc->m", surf.normals[found.triangle], -normals[ids])
     assert np.all((facing >= 0.5) | np.isclose(found.distance, 0))
     assert (found.distance > 0).mean() > 0.9  # it did look past the vertex's own triangles
+
+
+def test_tps_agrees_with_the_shared_rbf_warp(landmarks) -> None:  # type: ignore[no-untyped-def]
+    from facelib.engine.rbf import warp
+
+    target = _moved(landmarks)
+    rng = np.random.default_rng(9)
+    points = landmarks.mean(axis=0) + rng.normal(scale=0.08, size=(200, 3))
+    for kernel in ("linear", "thin_plate_spline"):
+        mine = fit_tps(landmarks, target, kernel=kernel)(points)
+        shared = warp(landmarks, target, points, kernel=kernel, degree=1)
+        assert np.abs(mine - shared).max() <= 1e-10, kernel

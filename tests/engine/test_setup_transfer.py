@@ -67,6 +67,8 @@ def test_x1_identity_is_exact(source) -> None:  # type: ignore[no-untyped-def]
     for mine, theirs in zip(face.regions, source.regions, strict=True):
         assert set(mine.vertices.tolist()) == set(theirs.vertices.tolist()), mine.name
         assert set(mine.anchors.tolist()) == set(theirs.anchors.tolist()), mine.name
+        assert (mine.deformer, mine.group, dict(mine.params)) == (
+            theirs.deformer, theirs.group, dict(theirs.params))
         if theirs.weights.size:
             order = np.argsort(theirs.vertices)
             np.testing.assert_allclose(mine.weights, theirs.weights[order], atol=1e-12)
@@ -276,4 +278,9 @@ def test_written_definition_round_trips(source, tmp_path: Path) -> None:  # type
     assert abs(again.operator - source.operator).max() == 0
     doc = json.loads(path.read_text())
     assert doc["mesh"] == "face.npz" and doc["name"] == "copy"
+    original = json.loads((Path(__file__).resolve().parents[2] / "facelib" / "data" / "head"
+                           / "default_head.json").read_text())
+    assert [(r["name"], r.get("group", "")) for r in doc["regions"]] == [
+        (r["name"], r.get("group", "")) for r in original["regions"]]
+    assert [r.deformer for r in again.regions] == [r.deformer for r in source.regions]
     assert sorted(p.name for p in path.parent.iterdir()) == ["face.json", "face.npz"]
