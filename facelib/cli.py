@@ -8,14 +8,17 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import facelib
 from facelib.errors import FacelibError
-from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4 import DIALECTS, FapStream, fap, read_fap, read_fap_file, write_fap
 from facelib.mpeg4.tables import FAPU_SCALE
+
+if TYPE_CHECKING:
+    from facelib.animation import Animation
 
 __all__ = ["main"]
 
@@ -53,7 +56,7 @@ def _check(args: argparse.Namespace) -> int:
     return 0
 
 
-def _animation(path: str, seed: int | None) -> Any:
+def _animation(path: str, seed: int | None) -> Animation | FapStream:
     """A storyboard's Animation, or a .fap file's stream."""
     if Path(path).suffix.lower() == ".fap":
         return read_fap(path)
@@ -287,6 +290,26 @@ def _add_render_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--fps", type=float, help="resample to this frame rate")
 
 
+def _add_face_commands(commands: Any) -> None:
+    """``facelib face setup``."""
+    face = commands.add_parser("face", help="make your own head mesh animatable")
+    face_commands = face.add_subparsers(dest="face_command", metavar="ACTION")
+    setup = face_commands.add_parser(
+        "setup", help="transfer the default face definition onto a head mesh")
+    setup.add_argument("mesh", help="head mesh: .obj, .ply, .glb/.gltf, .off or .stl")
+    setup.add_argument("--landmarks", help="JSON of feature point -> vertex index or [x, y, z]")
+    setup.add_argument("--auto", action="store_true",
+                       help="find the landmarks automatically (MediaPipe on a front view of "
+                            "the mesh; needs the track and render extras)")
+    setup.add_argument("-o", "--output", required=True, help="folder for face.json + face.npz")
+    setup.add_argument("--unit", choices=("m", "dm", "cm", "mm", "in"),
+                       help="the mesh's length unit (default: guessed from the landmarks)")
+    setup.add_argument("--part", action="append", default=[], metavar="PART=OBJECT",
+                       help="name the file's object for a part (eye_l, eye_r, teeth_upper, "
+                            "teeth_lower, tongue), e.g. --part eye_l=LeftEye")
+    setup.set_defaults(run=_face_setup)
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="facelib", description="Scriptable MPEG-4 facial animation."
@@ -308,8 +331,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("story", help="the .fdl storyboard")
     run.add_argument("-o", "--output", help="the .fap file (default: the storyboard's output)")
     run.add_argument("--seed", type=int, help="seed of the random processes")
-    run.add_argument("--dialect", default="standard",
-                     choices=("standard", "xface", "greta", "extended"))
+    run.add_argument("--dialect", default="standard", choices=DIALECTS)
     run.set_defaults(run=_run)
 
     render = commands.add_parser("render", help="render a storyboard (or .fap) to video")
@@ -332,22 +354,7 @@ def _build_parser() -> argparse.ArgumentParser:
     view.add_argument("--seed", type=int)
     view.set_defaults(run=_view)
 
-    face = commands.add_parser("face", help="make your own head mesh animatable")
-    face_commands = face.add_subparsers(dest="face_command", metavar="ACTION")
-    setup = face_commands.add_parser(
-        "setup", help="transfer the default face definition onto a head mesh")
-    setup.add_argument("mesh", help="head mesh: .obj, .ply, .glb/.gltf, .off or .stl")
-    setup.add_argument("--landmarks", help="JSON of feature point -> vertex index or [x, y, z]")
-    setup.add_argument("--auto", action="store_true",
-                       help="find the landmarks automatically (MediaPipe on a front view of "
-                            "the mesh; needs the track and render extras)")
-    setup.add_argument("-o", "--output", required=True, help="folder for face.json + face.npz")
-    setup.add_argument("--unit", choices=("m", "dm", "cm", "mm", "in"),
-                       help="the mesh's length unit (default: guessed from the landmarks)")
-    setup.add_argument("--part", action="append", default=[], metavar="PART=OBJECT",
-                       help="name the file's object for a part (eye_l, eye_r, teeth_upper, "
-                            "teeth_lower, tongue), e.g. --part eye_l=LeftEye")
-    setup.set_defaults(run=_face_setup)
+    _add_face_commands(commands)
 
     plot = commands.add_parser("plot", help="plot FAP curves of a storyboard or .fap")
     plot.add_argument("source", help="STORY.fdl or FILE.fap")
@@ -355,6 +362,13 @@ def _build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--seed", type=int)
     plot.set_defaults(run=_plot)
 
+    _add_align_command(commands)
+    _add_evaluate_command(commands)
+    _add_track_command(commands)
+    return parser
+
+
+def _add_align_command(commands: Any) -> None:
     align = commands.add_parser("align", help="align speech audio to visemes")
     align.add_argument("audio", help="speech audio (any format soundfile reads)")
     align.add_argument("--text", help="the transcript (omit for phone-loop recognition)")
@@ -363,6 +377,8 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.set_defaults(run=_align)
 
+
+def _add_evaluate_command(commands: Any) -> None:
     evaluate = commands.add_parser(
         "evaluate", help="compare deformers by lip roughness (CSV, Markdown, contact sheet)")
     evaluate.add_argument("-o", "--output", required=True, help="folder for the results")
@@ -374,8 +390,6 @@ def _build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--stem", default="deformers", help="file name stem")
     evaluate.add_argument("--no-sheet", action="store_true", help="skip the mouth contact sheet")
     evaluate.set_defaults(run=_evaluate)
-    _add_track_command(commands)
-    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
