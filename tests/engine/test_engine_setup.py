@@ -20,7 +20,7 @@ from facelib.errors import FaceModelError
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADS = ROOT / "examples" / "heads"
-SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
+SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 
 
 @pytest.fixture(scope="module")
