@@ -125,7 +125,7 @@ def _write_found(found: Any, folder: Path) -> None:
 
 
 def _face_setup(args: argparse.Namespace) -> int:
-    from facelib.engine.headmesh import load_head_mesh
+    from facelib.engine.headmesh import axes_rotation, load_head_mesh
     from facelib.engine.setup import set_up_face
     from facelib.engine.writer import write_face
 
@@ -138,13 +138,17 @@ def _face_setup(args: argparse.Namespace) -> int:
     parts = dict(item.split("=", 1) for item in args.part)
     mesh = load_head_mesh(args.mesh, parts=parts)
     landmarks: Any = args.landmarks
+    axes = {"up": args.up, "forward": args.forward}
     found = None
     if args.auto:
         from facelib.tracking.head_landmarks import detect_head_landmarks
 
+        if args.up is not None or args.forward is not None:  # upright before looking
+            mesh = mesh.rotated(axes_rotation(args.up or "+y", args.forward or "+z"))
+            axes = {"up": None, "forward": None}
         found = detect_head_landmarks(mesh)
         landmarks = found.as_json()
-    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit)
+    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit, **axes)
     out = write_face(result.face, Path(args.output) / "face.json", name=Path(args.mesh).stem,
                      source=f"facelib face setup {Path(args.mesh).name}")
     if found is not None:
@@ -304,6 +308,10 @@ def _add_face_commands(commands: Any) -> None:
     setup.add_argument("-o", "--output", required=True, help="folder for face.json + face.npz")
     setup.add_argument("--unit", choices=("m", "dm", "cm", "mm", "in"),
                        help="the mesh's length unit (default: guessed from the landmarks)")
+    for axis, default in (("up", "+y"), ("forward", "+z")):
+        setup.add_argument(f"--{axis}", choices=("+x", "-x", "+y", "-y", "+z", "-z"),
+                           help=f"the mesh's {axis} axis (default: guessed from the "
+                                f"landmarks; {default} for --auto)")
     setup.add_argument("--part", action="append", default=[], metavar="PART=OBJECT",
                        help="name the file's object for a part (eye_l, eye_r, teeth_upper, "
                             "teeth_lower, tongue), e.g. --part eye_l=LeftEye")

@@ -19,7 +19,11 @@ import numpy as np
 
 from facelib.errors import FaceModelError, MissingExtraError
 
-__all__ = ["MESH_SUFFIXES", "HeadMesh", "head_mesh", "load_head_mesh"]
+__all__ = ["AXES", "MESH_SUFFIXES", "HeadMesh", "axes_rotation", "head_mesh", "load_head_mesh"]
+
+AXES = {"+x": (1.0, 0.0, 0.0), "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0),
+        "-y": (0.0, -1.0, 0.0), "+z": (0.0, 0.0, 1.0), "-z": (0.0, 0.0, -1.0)}
+"""Axis names for a mesh's up and forward directions."""
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".off", ".stl")
 _PART_WORDS = (("tongue", r"tongue"), ("teeth", r"teeth|tooth"),
@@ -43,6 +47,11 @@ class HeadMesh:
     colors: np.ndarray | None = None
     name: str = "mesh"
 
+    def rotated(self, rotation: np.ndarray) -> HeadMesh:
+        """The same mesh with every vertex turned by ``rotation (3, 3)`` (``v -> R v``)."""
+        return HeadMesh(self.vertices @ np.asarray(rotation, np.float64).T, self.triangles,
+                        self.parts, self.colors, self.name)
+
     def part_triangles(self, name: str) -> np.ndarray:
         """(Fp, 3) int64 triangles of a part, re-indexed into ``parts[name]``."""
         ids = self.parts[name]
@@ -50,6 +59,24 @@ class HeadMesh:
         local[ids] = np.arange(ids.size)
         tris = local[self.triangles]
         return tris[(tris >= 0).all(axis=1)]
+
+
+def axes_rotation(up: str = "+y", forward: str = "+z") -> np.ndarray:
+    """The rotation ``(3, 3)`` that turns a mesh whose face points ``forward`` with ``up``
+    upwards into facelib's frame (+y up, looking along +z, +x the face's left).
+
+    Raises ParameterError for an unknown axis name or an ``up`` not at right angles to
+    ``forward``.
+    """
+    from facelib.errors import ParameterError
+
+    for name, value in (("up", up), ("forward", forward)):
+        if value not in AXES:
+            raise ParameterError(f"{name} axis {value!r} is not one of {', '.join(AXES)}")
+    u, f = np.array(AXES[up]), np.array(AXES[forward])
+    if abs(float(u @ f)) > 0:
+        raise ParameterError(f"up {up} and forward {forward} must be at right angles")
+    return np.stack([np.cross(u, f), u, f])
 
 
 def head_mesh(vertices: Any, triangles: Any, *, parts: Mapping[str, Any] | None = None,

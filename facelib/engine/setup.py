@@ -19,7 +19,7 @@ import numpy as np
 
 from facelib.engine.definition import default_face
 from facelib.engine.face import PART_NAMES, Face
-from facelib.engine.headmesh import HeadMesh, load_head_mesh
+from facelib.engine.headmesh import HeadMesh, axes_rotation, load_head_mesh
 from facelib.engine.surface import closest_points, surface
 from facelib.engine.tps import ThinPlateSpline, check_landmarks, fit_tps
 from facelib.engine.transfer import transfer_face
@@ -39,7 +39,8 @@ class FaceSetup:
 
     face: the new Face (metres, facelib's face frame).
     unit: the mesh unit used (a key of ``UNITS``).
-    rotation: (3, 3) float64 rotation applied to the mesh (identity if it was upright).
+    rotation: (3, 3) float64 rotation applied to the mesh, the given axes' included
+        (identity if it was upright).
     carried: parts the mesh lacked, warped into place from the source.
     landmarks: feature point ids used as landmarks, in fit order.
     residual: (n,) float64 metres: each landmark's distance to the mesh surface as given.
@@ -131,11 +132,19 @@ def _unit(scale: float, unit: str | None, extent: float) -> str:
 
 def set_up_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | str | Path,
                 source: Face | None = None, unit: str | None = None,
+                up: str | None = None, forward: str | None = None,
                 min_normal_cos: float = 0.5) -> FaceSetup:
     """Set a head mesh up for animation; see :func:`setup_face`. Returns a :class:`FaceSetup`."""
     src = default_face() if source is None else source
     head = mesh if isinstance(mesh, HeadMesh) else load_head_mesh(mesh)
     marks = read_landmarks(landmarks) if isinstance(landmarks, (str, Path)) else landmarks
+    given = np.eye(3)
+    if up is not None or forward is not None:
+        given = axes_rotation(up or "+y", forward or "+z")
+        head = head.rotated(given)
+        marks = {k: v if isinstance(v, (int, np.integer)) else
+                 (given @ np.asarray(v, np.float64).reshape(3)).tolist()
+                 for k, v in marks.items()}
     ids, points, vertices = _landmark_points(head, marks, src)
     source_points = src.vertices[[src.feature_points[i] for i in ids]].astype(np.float64)
     scale, rot = _similarity(source_points, points)
@@ -151,7 +160,7 @@ def set_up_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | s
     tps = fit_tps(source_points, points)
     carried = tuple(p for p in PART_NAMES if p not in head.parts)
     face = transfer_face(src, head, tps, vertices, min_cos=min_normal_cos)
-    return FaceSetup(face=face, unit=unit, rotation=rotation, carried=carried,
+    return FaceSetup(face=face, unit=unit, rotation=rotation @ given, carried=carried,
                      landmarks=tuple(ids), residual=residual, tps=tps)
 
 
@@ -174,6 +183,7 @@ def _residuals(head: HeadMesh, ids: Sequence[str], points: np.ndarray, src: Face
 
 def setup_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | str | Path,
                source: Face | None = None, unit: str | None = None,
+               up: str | None = None, forward: str | None = None,
                min_normal_cos: float = 0.5) -> Face:
     """Make a head mesh animatable: the source's face definition transferred onto it.
 
@@ -186,6 +196,8 @@ def setup_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | st
     source: the face whose definition is transferred (default: facelib's default head).
     unit: the mesh's length unit (``m``, ``dm``, ``cm``, ``mm``, ``in``); guessed from the
         landmarks' size when None.
+    up, forward: the mesh's up axis and the way its face looks (``"+z"``, ``"-y"``, ...);
+        when both are None the orientation is guessed from the landmarks.
     min_normal_cos: the normal check of the closest-point steps.
 
     Returns a Face in metres in facelib's face frame (a mesh whose landmarks are rotated
@@ -194,6 +206,6 @@ def setup_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | st
     Raises FaceModelError for a non-manifold or unwelded mesh, too few, duplicate or
     coplanar landmarks, a landmark off the surface, or a mesh in the wrong unit.
     """
-    return set_up_face(mesh, landmarks=landmarks, source=source, unit=unit,
-                       min_normal_cos=min_normal_cos).face
+    return set_up_face(mesh, landmarks=landmarks, source=source, unit=unit, up=up,
+                       forward=forward, min_normal_cos=min_normal_cos).face
 

@@ -16,7 +16,7 @@ from facelib.engine import default_face, load_face
 from facelib.engine.face import PART_NAMES
 from facelib.engine.headmesh import head_mesh, load_head_mesh
 from facelib.engine.setup import read_landmarks, set_up_face, setup_face
-from facelib.errors import FaceModelError
+from facelib.errors import FaceModelError, ParameterError
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADS = ROOT / "examples" / "heads"
@@ -168,3 +168,21 @@ def test_cli_bad_input_writes_nothing(tmp_path: Path, capsys) -> None:  # type: 
                  "-o", str(out)]) == 1
     assert "at least 4" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_given_axes_turn_a_z_up_mesh(cartoon, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    mesh, marks = cartoon
+    # a CAD-style copy: +z up, the face looking along -y
+    to_cad = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    cad = mesh.rotated(to_cad)
+    cad_marks = {k: (to_cad @ np.asarray(v)).tolist() for k, v in marks.items()}
+    upright = set_up_face(mesh, landmarks=marks).face
+    given = set_up_face(cad, landmarks=cad_marks, up="+z", forward="-y")
+    np.testing.assert_allclose(given.rotation, to_cad.T, atol=1e-12)
+    np.testing.assert_allclose(given.face.vertices, upright.vertices, atol=1e-6)
+    # guessed: the best rotation onto the default head's feature points, a few degrees
+    # from the true one since the cartoon has other proportions
+    guessed = set_up_face(cad, landmarks=cad_marks).rotation @ to_cad
+    assert np.degrees(np.arccos((np.trace(guessed) - 1) / 2)) < 5
+    with pytest.raises(ParameterError, match="right angles"):
+        setup_face(cad, landmarks=cad_marks, up="+z", forward="-z")
