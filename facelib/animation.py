@@ -27,7 +27,10 @@ class Animation:
     """A storyboard turned into FAPs.
 
     faps: the synchronized stream (what is rendered or written to ``.fap``).
-    audio: the speech audio to play with it, or None.
+    audio: the speech audio file to play with it, or None.
+    speech_audio: synthesized speech (``.samples``, ``.sample_rate``) to play with it when
+        the storyboard's speech is text without a recording, or None.
+    loudness: ``(n_frames,) float32`` dBFS of the speech under each frame, or None.
     audio_offset: seconds into the animation at which the audio starts.
     storyboard: the storyboard it came from.
     tracks: each generator's own track (``"expressions"``, ``"visemes"``, ``"gaze"``),
@@ -43,6 +46,8 @@ class Animation:
     tracks: Mapping[str, FapTrack] = field(default_factory=dict)
     visemes: Any = None
     gaze_events: Any = ()
+    speech_audio: Any = None
+    loudness: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "tracks", MappingProxyType(dict(self.tracks)))
@@ -62,7 +67,8 @@ def animate(
         storyboard = replace(storyboard, seed=int(seed))
     rules = rules or SyncRules.load()
     fps = storyboard.fps
-    speech = visemes.animate(storyboard.speech, fps=fps) if storyboard.speech else None
+    speech = (visemes.animate(storyboard.speech, fps=fps, language=storyboard.language)
+              if storyboard.speech else None)
     # one frame past the last cue's end, so the face is shown settling back to neutral
     n_frames = math.floor(storyboard.cues_end_ms * fps / 1000 + 1e-9) + 1
     if speech is not None:
@@ -92,6 +98,8 @@ def animate(
         tracks={"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track},
         visemes=None if speech is None else speech.timeline,
         gaze_events=eyes.events,
+        speech_audio=None if speech is None else speech.audio,
+        loudness=None if speech is None else speech.loudness,
     )
 
 

@@ -3,7 +3,8 @@
 One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts, or the
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
-``fps`` (default 25), ``seed`` (default 0) and ``output`` set the storyboard options.
+``fps`` (default 25), ``seed`` (default 0), ``output`` and ``language`` (default English; the
+language of speech that names none) set the storyboard options.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ __all__ = ["load", "loads"]
 log = logging.getLogger("facelib.fdl")
 
 DEFAULT_FPS = 25.0
-SETTINGS = ("fps", "seed", "output", "FDL", "expressions", "eyes", "Sentence")
+SETTINGS = ("fps", "seed", "output", "language", "FDL", "expressions", "eyes", "Sentence")
 """Globals a storyboard may set (besides its own helpers and variables)."""
 _MAX_FPS = 1000.0
 
@@ -225,8 +226,13 @@ def _build(
             base_dir, output_value, what="output", path=name, line=output_line, must_exist=False
         )
     )
+    language = _global(chunk, "language")
+    if language is not None and not (isinstance(language, str) and language.strip()):
+        raise FdlError(f"language must be a language code like \"pt\"; got {language!r}",
+                       path=name, line=_line(text, "language"))
     return Storyboard(
         path=file,
+        language=language.strip() if isinstance(language, str) else None,
         fps=float(fps),
         seed=seed,
         speech=speech,
@@ -383,7 +389,8 @@ def _speech(
             )
             text = read_text(transcript, what="transcript", path=ctx.path, line=said.line)
         return SpeechSpec(
-            audio=audio, text=text, visemes=visemes, start_ms=start, origin=_origin(ctx, said.line)
+            audio=audio, text=text, visemes=visemes, start_ms=start, origin=_origin(ctx, said.line),
+            lang=said.lang, voice=said.voice, rate=said.rate, pitch=said.pitch,
         )
     if not fdl_speech and sentence is None:
         return None

@@ -29,7 +29,8 @@ FUNCTIONS = ("say", "show", "look", "define_expression", "define_gaze")
 
 _SHOW_FIELDS = ("at", "dur", "intensity", "ease_in", "ease_out")
 _LOOK_FIELDS = ("at", "dur")
-_SAY_FIELDS = ("text", "transcript", "audio", "visemes", "at")
+_SAY_FIELDS = ("text", "transcript", "audio", "visemes", "at", "lang", "voice", "rate", "pitch")
+_SAY_RANGES = {"rate": (0.5, 2.5), "pitch": (0.0, 100.0)}
 _MAX_FAP_VALUE = 100_000.0
 
 
@@ -57,6 +58,10 @@ class DraftSpeech:
     transcript: str | None = None
     audio: str | None = None
     visemes: tuple[tuple[str, int, int | None], ...] | None = None
+    lang: str | None = None
+    voice: str | None = None
+    rate: float = 1.0
+    pitch: float = 50.0
 
 
 @dataclass(slots=True)
@@ -235,9 +240,15 @@ def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> Non
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
-    for key in ("text", "transcript", "audio"):
+    for key in ("text", "transcript", "audio", "lang", "voice"):
         if key in f and not isinstance(f[key], str):
             raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
+    for key, (low, high) in _SAY_RANGES.items():
+        value = f.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
+                                  or not low <= value <= high):
+            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
+                           path=ctx.path, line=line)
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
@@ -248,6 +259,10 @@ def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> Non
         transcript=f.get("transcript"),
         audio=f.get("audio"),
         visemes=visemes,
+        lang=f.get("lang"),
+        voice=f.get("voice"),
+        rate=float(f.get("rate", 1.0)),
+        pitch=float(f.get("pitch", 50.0)),
     )
 
 

@@ -1,0 +1,169 @@
+"""Alignment of recorded speech in any language by dynamic time warping (the technique of
+the aeneas aligner): the transcript is synthesized with espeak-ng (phone times known to the
+sample), both signals become MFCC sequences, librosa's DTW finds the cheapest monotonic
+match between them, and each synthesized phone boundary is carried through that warp into
+the recording.
+
+Memory stays bounded for long recordings: a recording over 30 s is aligned sentence by
+sentence; each sentence is matched inside a window of the recording that starts where the
+previous one ended (fixed start, open end), so the cost matrix is never larger than a
+sentence by its window.
+"""
+
+from __future__ import annotations
+
+import re
+from math import gcd
+from pathlib import Path
+
+import numpy as np
+
+from facelib.errors import MissingExtraError, SpeechError
+from facelib.speech.audio import ALIGN_RATE, load_speech
+from facelib.speech.synth import DEFAULT_LANGUAGE, synthesize
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
+
+__all__ = ["HOP_MS", "align_dtw", "mfcc_features"]
+
+HOP_MS = 10
+"""Feature frame step (ms): the resolution of the warp."""
+_N_MFCC = 13
+_WINDOW_FACTOR = 1.6
+"""A sentence is searched in a window of the recording this many times its synthesized
+length, plus ``_WINDOW_EXTRA_S``, from where the previous sentence ended."""
+_WINDOW_EXTRA_S = 3.0
+_WHOLE_MAX_S = 30.0
+"""Recordings up to this long are warped in one piece (cost matrix ~3000 x 3000 frames);
+longer ones sentence by sentence."""
+_SENTENCE = re.compile(r"[^.!?;:]+[.!?;:]*")
+
+
+def mfcc_features(samples: np.ndarray) -> np.ndarray:
+    """``(n_frames, 12) float32`` MFCCs 1-12 (no energy term) of 16 kHz ``samples``, one frame
+    every :data:`HOP_MS` (25 ms windows), each coefficient normalised to zero mean and unit
+    variance over the signal (so voices and recording levels compare)."""
+    try:
+        import librosa
+    except ImportError as exc:
+        raise MissingExtraError("alignment in any language", "speech", "librosa") from exc
+    hop = ALIGN_RATE * HOP_MS // 1000
+    mfcc = librosa.feature.mfcc(y=np.asarray(samples, np.float32), sr=ALIGN_RATE,
+                                n_mfcc=_N_MFCC, n_fft=512, win_length=400, hop_length=hop,
+                                n_mels=40)[1:]
+    mfcc -= mfcc.mean(axis=1, keepdims=True)
+    mfcc /= mfcc.std(axis=1, keepdims=True) + 1e-6
+    return np.ascontiguousarray(mfcc.T, dtype=np.float32)
+
+
+def _to_align_rate(samples: np.ndarray, rate: int) -> np.ndarray:
+    from scipy.signal import resample_poly
+
+    g = gcd(ALIGN_RATE, rate)
+    return resample_poly(samples, ALIGN_RATE // g, rate // g).astype(np.float32)
+
+
+def _warp(syn: np.ndarray, rec: np.ndarray, *, open_end: bool) -> np.ndarray:
+    """For each synthesized frame, the recording frame it matches, ``(len(syn),) float64``
+    (mean over the path, non-decreasing). Both start at frame 0; with ``open_end`` the match
+    may end before the end of ``rec`` (where the path cost per step is least)."""
+    import librosa
+
+    acc, steps = librosa.sequence.dtw(X=syn.T, Y=rec.T, metric="euclidean", backtrack=False,
+                                      return_steps=True)
+    if open_end:
+        per_step = acc[-1] / (len(syn) + np.arange(1, len(rec) + 1))
+        path = librosa.sequence.dtw_backtracking(steps, subseq=True,
+                                                 start=int(np.argmin(per_step)))
+    else:
+        path = librosa.sequence.dtw_backtracking(steps, subseq=False)
+    path = np.asarray(path, dtype=np.int64)
+    del acc, steps
+    sums = np.bincount(path[:, 0], weights=path[:, 1], minlength=len(syn))
+    counts = np.bincount(path[:, 0], minlength=len(syn))
+    mapped: np.ndarray = np.maximum.accumulate(sums / np.maximum(counts, 1))
+    return mapped
+
+
+def _sentences(text: str) -> list[str]:
+    found = [s.strip() for s in _SENTENCE.findall(text) if s.strip()]
+    return found or [text]
+
+
+def align_dtw(
+    audio: str | Path | np.ndarray,
+    text: str,
+    *,
+    lang: str = DEFAULT_LANGUAGE,
+    voice: str | None = None,
+    sample_rate: int | None = None,
+) -> PhoneTimeline:
+    """Phones (IPA) and words of recorded speech ``audio`` saying ``text`` in ``lang``.
+
+    ``audio`` is a sound file or an array (with ``sample_rate``), as for
+    :func:`facelib.speech.align`; ``voice`` is the espeak-ng voice to synthesize the
+    transcript with (default: the language's). Returns a timeline in ms from the start of
+    the audio, ``source="dtw"``, ``alphabet="ipa"``. Raises SpeechError for unreadable or
+    silent audio or a transcript without words; MissingExtraError without the speech extra.
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise SpeechError(f"transcript {text!r} has no words")
+    rec_samples = load_speech(audio, sample_rate=sample_rate)
+    rec = mfcc_features(rec_samples)
+    duration_ms = round(rec_samples.size * 1000 / ALIGN_RATE)
+    del rec_samples
+    phones: list[Span] = []
+    words: list[Span] = []
+    cursor = 0
+    parts = _sentences(text) if duration_ms > _WHOLE_MAX_S * 1000 else [text]
+    for k, sentence in enumerate(parts):
+        syn = synthesize(sentence, lang=lang, voice=voice)
+        feats = mfcc_features(_to_align_rate(np.asarray(syn.samples), syn.sample_rate))
+        last = k + 1 == len(parts)
+        if last:
+            window = rec[cursor:]
+        else:
+            size = int(len(feats) * _WINDOW_FACTOR + _WINDOW_EXTRA_S * 1000 / HOP_MS)
+            window = rec[cursor:cursor + size]
+        if len(window) < 2:
+            raise SpeechError(f"the recording ends before the sentence {sentence[:40]!r}",
+                              path=None if isinstance(audio, np.ndarray) else audio)
+        mapped = _warp(feats, window, open_end=not last)
+        offset = cursor
+
+        def to_rec_ms(ms: int, mapped: np.ndarray = mapped, offset: int = offset) -> int:
+            i = min(int(round(ms / HOP_MS)), len(mapped) - 1)
+            return int(round((mapped[i] + offset) * HOP_MS))
+
+        for span in syn.timeline.phones:
+            _extend(phones, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+        for span in syn.timeline.words:
+            _extend(words, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+        cursor = offset + int(np.ceil(mapped[-1]))
+    return PhoneTimeline(_cover(phones, duration_ms), _cover(words, duration_ms), "dtw",
+                         duration_ms, alphabet="ipa")
+
+
+def _extend(spans: list[Span], label: str, start: int, end: int) -> None:
+    """Append ``[start, end)`` after the spans so far (clipped to begin where they end),
+    joining silences and filling gaps with silence; empty spans are dropped."""
+    if spans:
+        start = max(start, spans[-1].end_ms)
+        if spans[-1].end_ms < start:
+            _extend(spans, SILENCE, spans[-1].end_ms, start)
+    if end <= start:
+        return
+    if spans and label == SILENCE and spans[-1].label == SILENCE:
+        spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
+    else:
+        spans.append(Span(label, start, end))
+
+
+def _cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
+    out: list[Span] = []
+    if spans and spans[0].start_ms > 0:
+        out.append(Span(SILENCE, 0, spans[0].start_ms))
+    for s in spans:
+        _extend(out, s.label, min(s.start_ms, duration_ms), min(s.end_ms, duration_ms))
+    if out and out[-1].end_ms < duration_ms:
+        _extend(out, SILENCE, out[-1].end_ms, duration_ms)
+    return tuple(out)
