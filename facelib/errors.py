@@ -94,3 +94,8 @@ class FacelibWarning(UserWarning):
 
 class SpeechWarning(FacelibWarning):
     """An alignment succeeded but looks implausible (named word, reason)."""
+
+
+class PronunciationWarning(SpeechWarning):
+    """Words could not be pronounced as written (not in the dictionary: guessed from their
+    spelling); the message names every one."""

@@ -13,13 +13,12 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from functools import cache
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
-from facelib.errors import ParameterError, SpeechError, SpeechWarning
+from facelib.errors import ParameterError, PronunciationWarning, SpeechError, SpeechWarning
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.pronounce import model_dir, pronounce, tokenize
 from facelib.speech.tables import alignment_settings, phone_durations
@@ -32,10 +31,10 @@ _NOISE = {"SIL", "NSN", "SPN", "<sil>", "<s>", "</s>", "[NOISE]", "+NSN+", "+SPN
 _PHONE_LOOP = "_facelib_phone_loop"
 
 
-@cache
 def _decoder(*, wide: bool = False) -> Any:
-    """One pocketsphinx decoder per process and beam setting (loading the model takes
-    about a second); ``wide`` gives the fallback with the wide beams of alignment.json."""
+    """A new pocketsphinx decoder (``wide``: with the wide beams of alignment.json). Not
+    kept: a decoder holds on to the memory of its last search (gigabytes after a long
+    recording), so each alignment loads the model afresh (about a second) and frees it."""
     try:
         from pocketsphinx import Decoder
     except ImportError as exc:
@@ -94,7 +93,11 @@ def align(
     if text is None:
         phones = _phone_loop(pcm, duration_ms)
         return PhoneTimeline(phones, (), "phone-loop", duration_ms)
-    phones, words, problems = _forced(pcm, text, duration_ms, where)
+    phones, words, problems, guessed = _forced(pcm, text, duration_ms, where)
+    if guessed:
+        warnings.warn(f"not in the pronunciation dictionary, pronounced as spelt: "
+                      f"{', '.join(repr(w) for w in guessed)}", PronunciationWarning,
+                      stacklevel=2)
     if problems and on_implausible != "ignore":
         message = "implausible alignment: " + "; ".join(problems)
         if on_implausible == "raise":
@@ -111,7 +114,7 @@ def _decode(decoder: Any, pcm: bytes) -> None:
 
 def _forced(
     pcm: bytes, text: str, duration_ms: int, where: str | Path | None
-) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str], list[str]]:
     words = [t for t in tokenize(text) if t[0].isalpha()]
     try:
         return _forced_with(_decoder(), pcm, words, text=text, duration_ms=duration_ms,
@@ -126,7 +129,7 @@ def _forced(
 def _forced_with(
     decoder: Any, pcm: bytes, words: list[str], *, text: str, duration_ms: int,
     where: str | Path | None,
-) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str], list[str]]:
     guessed = []
     for word in words:
         if decoder.lookup_word(word) is None:
@@ -169,7 +172,8 @@ def _forced_with(
             problems += _check_word(name, word_phones, settings, name in guessed, final=final)
         else:
             problems += _check_pause(word_spans, word_phones, settings)
-    return _cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems
+    return (_cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems,
+            guessed)
 
 
 def _shift_boundaries(

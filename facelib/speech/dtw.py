@@ -131,8 +131,8 @@ def align_dtw(
         offset = cursor
 
         def to_rec_ms(ms: int, mapped: np.ndarray = mapped, offset: int = offset) -> int:
-            i = min(int(round(ms / HOP_MS)), len(mapped) - 1)
-            return int(round((mapped[i] + offset) * HOP_MS))
+            i = min(round(ms / HOP_MS), len(mapped) - 1)
+            return round(float(mapped[i] + offset) * HOP_MS)
 
         for span in syn.timeline.phones:
             _extend(phones, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))

@@ -3,7 +3,14 @@ while a writer drafts a storyboard before the voice is recorded."""
 
 from __future__ import annotations
 
-from facelib.errors import MissingExtraError, ParameterError, SpeechError
+import warnings
+
+from facelib.errors import (
+    MissingExtraError,
+    ParameterError,
+    PronunciationWarning,
+    SpeechError,
+)
 from facelib.speech.pronounce import letter_to_sound, pronounce, tokenize
 from facelib.speech.tables import pauses as pause_table
 from facelib.speech.tables import phone_durations
@@ -20,11 +27,14 @@ _VOWELS = frozenset(
 )
 
 
-def _phones_of(word: str) -> tuple[str, ...]:
+def _phones_of(word: str, guessed: list[str]) -> tuple[str, ...]:
     try:
-        return pronounce(word)[0]
+        phones, known = pronounce(word)
     except MissingExtraError:  # no dictionary without the speech extra: spell it out
-        return letter_to_sound(word)
+        phones, known = letter_to_sound(word), False
+    if not known:
+        guessed.append(word)
+    return phones
 
 
 def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
@@ -36,6 +46,7 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
     pauses = pause_table()
     table = phone_durations()
     tokens = tokenize(text)
+    guessed: list[str] = []
     phones: list[Span] = []
     words: list[Span] = []
     t = round(pauses["edge"] / rate)
@@ -46,7 +57,7 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
             continue
         following = tokens[k + 1] if k + 1 < len(tokens) else None
         pause = pauses.get(following, 0) if following else pauses["edge"]
-        word_phones = _phones_of(token)
+        word_phones = _phones_of(token, guessed)
         n_vowels = sum(p in _VOWELS for p in word_phones)
         start = t
         for i, phone in enumerate(word_phones):
@@ -66,6 +77,10 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
             phones.append(Span(SILENCE, t, t + ms))
             words.append(Span(SILENCE, t, t + ms))
             t += ms
+    if guessed:
+        warnings.warn(f"not in the pronunciation dictionary, pronounced as spelt: "
+                      f"{', '.join(repr(w) for w in dict.fromkeys(guessed))}", PronunciationWarning,
+                      stacklevel=2)
     phones = _join_silences(phones)
     words = _join_silences(words)
     return PhoneTimeline(tuple(phones), tuple(words), "durations", t)

@@ -146,12 +146,25 @@ def _collecting() -> Iterator[tuple[list[np.ndarray], list[EspeakEvent]]]:
         lib.espeak_SetSynthCallback(_CALLBACK())
 
 
-def synth_raw(text: str, *, voice: str, words_per_minute: int, pitch: int) -> RawSynthesis:
+@cache
+def _libc() -> Any:
+    return ctypes.CDLL(None)
+
+
+def synth_raw(text: str, *, voice: str, words_per_minute: int, pitch: int,
+              seed: int = 0) -> RawSynthesis:
     """Speak ``text`` (plain UTF-8, no SSML) with espeak-ng ``voice`` (a language code or a
     voice identifier, ``"+variant"`` allowed) at ``words_per_minute`` (80-450) and
-    ``pitch`` (0-100, 50 the voice's own). Raises SpeechError for an unknown voice."""
+    ``pitch`` (0-100, 50 the voice's own). Raises SpeechError for an unknown voice.
+
+    espeak-ng varies its output with a pseudo-random generator (pitch jitter, noise
+    sources, some phone lengths); it is seeded with ``seed`` first
+    (``espeak_ng_SetRandSeed``, and the C library's ``srand``), so the same text, voice and
+    seed give the same samples and times, bit for bit."""
     lib, rate = _library()
     with _LOCK:
+        lib.espeak_ng_SetRandSeed(ctypes.c_long(seed))
+        _libc().srand(ctypes.c_uint(seed & 0xFFFFFFFF))
         if lib.espeak_SetVoiceByName(voice.encode()) != 0:
             raise SpeechError(f"espeak-ng has no voice {voice!r} (see `facelib list voices`)")
         lib.espeak_SetParameter(_PARAM_RATE, int(words_per_minute), 0)

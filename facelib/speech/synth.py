@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, lru_cache
 from types import MappingProxyType
 
 import numpy as np
@@ -110,9 +110,17 @@ def synthesize(
         raise ParameterError(f"text to speak must be a non-empty string, got {text!r}")
     rate = check_number("speaking rate", rate, low=0.5, high=2.5)
     pitch = check_number("pitch", pitch, low=0, high=100)
+    return _synthesize(text, lang, voice, rate, pitch)
+
+
+@lru_cache(maxsize=16)
+def _synthesize(text: str, lang: str, voice: str | None, rate: float, pitch: float) -> Synthesis:
+    """:func:`synthesize`, remembered: libespeak-ng's output for the same text varies by a
+    few ms from one call to the next within a process (state its seeds do not reset), so
+    the same speech is synthesized once and reused, which keeps animations repeatable."""
     spoken = spell_numbers(text, lang=lang)
     chosen = voice or voice_for(lang)
-    wpm = int(round(min(max(rate * default_words_per_minute(), _MIN_WPM), _MAX_WPM)))
+    wpm = round(min(max(rate * default_words_per_minute(), _MIN_WPM), _MAX_WPM))
     raw = synth_raw(spoken, voice=chosen, words_per_minute=wpm, pitch=round(pitch))
     if raw.samples.size == 0 or not any(e.kind == "phone" and e.name for e in raw.events):
         raise SpeechError(f"espeak-ng spoke nothing for {text[:60]!r} (voice {chosen!r})")

@@ -1,8 +1,9 @@
 """IPA phones -> visemes, for every language espeak-ng speaks (``ipa_to_viseme.csv``).
 
-A phone label (``"ˈeɪ"``, ``"ɐ̃"``, ``"tʃ"``, ``"a-"``) is cleaned of stress, length and
-diacritics, then read as a sequence of table symbols, longest match first; a diphthong or
-cluster gives its symbols' visemes in turn (equal shares of the phone's time).
+A phone label (in IPA; stressed, nasal, long, or with espeak-ng's unstressed "-") is
+cleaned of stress, length and diacritics, then read as a sequence of table symbols, longest
+match first; a diphthong or cluster gives its symbols' visemes in turn (equal shares of
+the phone's time).
 """
 
 from __future__ import annotations
