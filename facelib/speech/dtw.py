@@ -20,7 +20,7 @@ import numpy as np
 
 from facelib.errors import MissingExtraError, SpeechError
 from facelib.speech.audio import ALIGN_RATE, load_speech
-from facelib.speech.synth import DEFAULT_LANGUAGE, synthesize
+from facelib.speech.synth import DEFAULT_LANGUAGE, synthesize_many
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 
 __all__ = ["HOP_MS", "align_dtw", "mfcc_features"]
@@ -115,8 +115,8 @@ def align_dtw(
     words: list[Span] = []
     cursor = 0
     parts = _sentences(text) if duration_ms > _WHOLE_MAX_S * 1000 else [text]
-    for k, sentence in enumerate(parts):
-        syn = synthesize(sentence, lang=lang, voice=voice)
+    spoken = synthesize_many(parts, lang=lang, voice=voice)
+    for k, (sentence, syn) in enumerate(zip(parts, spoken, strict=True)):
         feats = mfcc_features(_to_align_rate(np.asarray(syn.samples), syn.sample_rate))
         last = k + 1 == len(parts)
         if last:

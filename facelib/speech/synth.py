@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache, lru_cache
+from functools import cache
 from types import MappingProxyType
 
 import numpy as np
@@ -23,13 +23,13 @@ from facelib.speech.espeak import (
     EspeakEvent,
     default_words_per_minute,
     list_voices,
-    synth_raw,
+    synth_fresh,
 )
 from facelib.speech.normalize import spell_numbers
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 
 __all__ = ["DEFAULT_LANGUAGE", "Language", "Synthesis", "languages", "list_voices",
-           "synthesize", "voice_for"]
+           "synthesize", "synthesize_many", "voice_for"]
 
 DEFAULT_LANGUAGE = "en"
 """The language of speech when neither the speech nor the storyboard names one."""
@@ -108,27 +108,39 @@ def synthesize(
     """
     if not isinstance(text, str) or not text.strip():
         raise ParameterError(f"text to speak must be a non-empty string, got {text!r}")
+    return synthesize_many([text], lang=lang, voice=voice, rate=rate, pitch=pitch)[0]
+
+
+def synthesize_many(
+    texts: Sequence[str],
+    *,
+    lang: str = DEFAULT_LANGUAGE,
+    voice: str | None = None,
+    rate: float = 1.0,
+    pitch: float = 50,
+) -> list[Synthesis]:
+    """:func:`synthesize` of each of ``texts`` (same options), in one fresh espeak-ng
+    process (:func:`facelib.speech.espeak.synth_fresh`): the result depends only on the
+    arguments, bit for bit."""
+    for text in texts:
+        if not isinstance(text, str) or not text.strip():
+            raise ParameterError(f"text to speak must be a non-empty string, got {text!r}")
     rate = check_number("speaking rate", rate, low=0.5, high=2.5)
     pitch = check_number("pitch", pitch, low=0, high=100)
-    return _synthesize(text, lang, voice, rate, pitch)
-
-
-@lru_cache(maxsize=16)
-def _synthesize(text: str, lang: str, voice: str | None, rate: float, pitch: float) -> Synthesis:
-    """:func:`synthesize`, remembered: libespeak-ng's output for the same text varies by a
-    few ms from one call to the next within a process (state its seeds do not reset), so
-    the same speech is synthesized once and reused, which keeps animations repeatable."""
-    spoken = spell_numbers(text, lang=lang)
     chosen = voice or voice_for(lang)
     wpm = round(min(max(rate * default_words_per_minute(), _MIN_WPM), _MAX_WPM))
-    raw = synth_raw(spoken, voice=chosen, words_per_minute=wpm, pitch=round(pitch))
-    if raw.samples.size == 0 or not any(e.kind == "phone" and e.name for e in raw.events):
-        raise SpeechError(f"espeak-ng spoke nothing for {text[:60]!r} (voice {chosen!r})")
-    samples = (raw.samples.astype(np.float32) / 32768.0)
-    samples.flags.writeable = False
-    timeline = events_to_timeline(raw.events, spoken, n_samples=raw.samples.size,
-                                  sample_rate=raw.sample_rate)
-    return Synthesis(samples, raw.sample_rate, timeline, spoken, chosen)
+    spoken = [spell_numbers(text, lang=lang) for text in texts]
+    raws = synth_fresh([(s, chosen, wpm, round(pitch)) for s in spoken])
+    out = []
+    for text, said, raw in zip(texts, spoken, raws, strict=True):
+        if raw.samples.size == 0 or not any(e.kind == "phone" and e.name for e in raw.events):
+            raise SpeechError(f"espeak-ng spoke nothing for {text[:60]!r} (voice {chosen!r})")
+        samples = raw.samples.astype(np.float32) / 32768.0
+        samples.flags.writeable = False
+        timeline = events_to_timeline(raw.events, said, n_samples=raw.samples.size,
+                                      sample_rate=raw.sample_rate)
+        out.append(Synthesis(samples, raw.sample_rate, timeline, said, chosen))
+    return out
 
 
 def events_to_timeline(
