@@ -106,13 +106,35 @@ def _plot(args: argparse.Namespace) -> int:
 
 
 def _align(args: argparse.Namespace) -> int:
-    from facelib.visemes import align, write_timeline
+    from facelib.visemes import align, align_dtw, write_timeline
 
     text = args.text
     if args.text_file is not None:
         text = Path(args.text_file).read_text(encoding="utf-8")
-    out = write_timeline(align(args.audio, text), args.output, fps=args.fps)
+    if args.lang.lower().startswith("en"):
+        timeline = align(args.audio, text)
+    elif text is None:
+        raise FacelibError(f"aligning speech in {args.lang!r} needs its transcript (--text)")
+    else:
+        timeline = align_dtw(args.audio, text, lang=args.lang)
+    out = write_timeline(timeline, args.output, fps=args.fps)
     print(f"wrote {out}")
+    return 0
+
+
+def _list(args: argparse.Namespace) -> int:
+    from facelib.speech.synth import languages, list_voices
+
+    if args.what == "languages":
+        for lang in languages().values():
+            print(f"{lang.lang}\t{lang.voice}\t{lang.name}")
+        return 0
+    wanted = (args.lang or "").lower()
+    for voice in list_voices():
+        if wanted and not any(code.startswith(wanted) for code in voice.languages):
+            continue
+        print(f"{voice.identifier}\t{','.join(voice.languages)}\t{voice.gender or '-'}"
+              f"\t{voice.name}")
     return 0
 
 
@@ -182,7 +204,15 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("--text-file", help="a file holding the transcript")
     align.add_argument("-o", "--output", required=True, help="OUT.json, OUT.tsv or OUT.sb")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
+    align.add_argument("--lang", default="en",
+                       help="language of the speech (en: pocketsphinx; others: DTW against "
+                            "espeak-ng)")
     align.set_defaults(run=_align)
+
+    listing = commands.add_parser("list", help="list speech voices or tested languages")
+    listing.add_argument("what", choices=("voices", "languages"))
+    listing.add_argument("--lang", help="only voices of this language (voices)")
+    listing.set_defaults(run=_list)
     return parser
 
 

@@ -17,9 +17,10 @@ from facelib.speech import align as align_phones
 from facelib.speech import timeline_from_text as phones_from_text
 from facelib.speech.align import OnImplausible
 from facelib.speech.audio import ALIGN_RATE, load_speech
-from facelib.speech.dtw import align_dtw
+from facelib.speech.dtw import align_dtw as align_phones_dtw
 from facelib.speech.loudness import FLOOR_DB, phone_loudness
-from facelib.speech.synth import DEFAULT_LANGUAGE, synthesize
+from facelib.speech.synth import DEFAULT_LANGUAGE
+from facelib.speech.synth import synthesize as synthesize_speech
 from facelib.speech.timeline import PhoneTimeline
 from facelib.visemes.coarticulation import (
     blend,
@@ -32,8 +33,8 @@ from facelib.visemes.mapping import with_visemes
 from facelib.visemes.scripts import visemes_from_cues
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
-__all__ = ["SpeechAudio", "VisemeAnimation", "align", "animate", "speech_timeline",
-           "timeline_from_text"]
+__all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate",
+           "speech_timeline", "synthesize", "timeline_from_text"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,6 +80,21 @@ def align(audio: str | Path | np.ndarray, text: str | None = None, *,
                                      on_implausible=on_implausible))
 
 
+def align_dtw(audio: str | Path | np.ndarray, text: str, *, lang: str = DEFAULT_LANGUAGE,
+              voice: str | None = None, sample_rate: int | None = None) -> SpeechTimeline:
+    """:func:`facelib.speech.dtw.align_dtw` (any language) with the visemes of its phones."""
+    return with_visemes(align_phones_dtw(audio, text, lang=lang, voice=voice,
+                                         sample_rate=sample_rate))
+
+
+def synthesize(text: str, *, lang: str = DEFAULT_LANGUAGE, voice: str | None = None,
+               rate: float = 1.0, pitch: float = 50) -> tuple[SpeechTimeline, SpeechAudio]:
+    """:func:`facelib.speech.synthesize` (same arguments): the timeline with visemes, and
+    the audio."""
+    made = synthesize_speech(text, lang=lang, voice=voice, rate=rate, pitch=pitch)
+    return with_visemes(made.timeline), SpeechAudio(made.samples, made.sample_rate)
+
+
 def timeline_from_text(text: str, *, rate: float = 1.0) -> SpeechTimeline:
     """:func:`facelib.speech.timeline_from_text` with the visemes of its phones."""
     return with_visemes(phones_from_text(text, rate=rate))
@@ -112,7 +128,7 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
                               f"{speech.origin[1]})", path=exc.path) from exc
     if speech.text:
         try:
-            made = synthesize(speech.text, lang=lang, voice=speech.voice,
+            made = synthesize_speech(speech.text, lang=lang, voice=speech.voice,
                               rate=min(max(speech.rate * rate, 0.5), 2.5), pitch=speech.pitch)
         except MissingExtraError:
             if not lang.lower().startswith("en"):
@@ -135,11 +151,11 @@ def _recorded(audio: Path, text: str | None, lang: str, voice: str | None) -> Ph
         except SpeechError:
             if text is None:
                 raise
-            return align_dtw(audio, text, lang=lang, voice=voice)
+            return align_phones_dtw(audio, text, lang=lang, voice=voice)
     if text is None:
         raise SpeechError(f"speech audio in {lang!r} needs its transcript (recognition without "
                           "one is English only)", path=audio)
-    return align_dtw(audio, text, lang=lang, voice=voice)
+    return align_phones_dtw(audio, text, lang=lang, voice=voice)
 
 
 def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
