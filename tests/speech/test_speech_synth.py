@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from facelib.cues import SpeechSpec
-from facelib.mpeg4.tables import fap
 from facelib.errors import ParameterError, SpeechError
+from facelib.mpeg4.tables import fap
 from facelib.speech import list_voices, synthesize
 from facelib.speech.synth import languages
 from facelib.visemes import animate
