@@ -13,6 +13,7 @@ sentence by its window.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Iterator
 from math import gcd
 from pathlib import Path
 
@@ -20,14 +21,15 @@ import numpy as np
 
 from facelib.errors import MissingExtraError, SpeechError
 from facelib.speech.audio import ALIGN_RATE, load_speech
-from facelib.speech.synth import DEFAULT_LANGUAGE, synthesize_many
+from facelib.speech.synth import DEFAULT_LANGUAGE, Synthesis, synthesize_many
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 
-__all__ = ["HOP_MS", "align_dtw", "mfcc_features"]
+__all__ = ["HOP_MS", "align_dtw", "mfcc_features", "sentence_spans"]
 
 HOP_MS = 10
 """Feature frame step (ms): the resolution of the warp."""
 _N_MFCC = 13
+_BLOCK_FRAMES = 6000  # one minute of feature frames per block
 _WINDOW_FACTOR = 1.6
 """A sentence is searched in a window of the recording this many times its synthesized
 length, plus ``_WINDOW_EXTRA_S``, from where the previous sentence ended."""
@@ -40,16 +42,28 @@ _SENTENCE = re.compile(r"[^.!?;:]+[.!?;:]*")
 
 def mfcc_features(samples: np.ndarray) -> np.ndarray:
     """``(n_frames, 12) float32`` MFCCs 1-12 (no energy term) of 16 kHz ``samples``, one frame
-    every :data:`HOP_MS` (25 ms windows), each coefficient normalised to zero mean and unit
-    variance over the signal (so voices and recording levels compare)."""
+    every :data:`HOP_MS` (25 ms windows centred on the frame times), each coefficient
+    normalised to zero mean and unit variance over the signal (so voices and recording
+    levels compare). Computed in blocks of a minute, so a long recording never needs its
+    whole spectrogram at once."""
     try:
         import librosa
     except ImportError as exc:
         raise MissingExtraError("alignment in any language", "speech", "librosa") from exc
     hop = ALIGN_RATE * HOP_MS // 1000
-    mfcc = librosa.feature.mfcc(y=np.asarray(samples, np.float32), sr=ALIGN_RATE,
-                                n_mfcc=_N_MFCC, n_fft=512, win_length=400, hop_length=hop,
-                                n_mels=40)[1:]
+    n_fft = 512
+    x = np.asarray(samples, np.float32).reshape(-1)
+    n_frames = 1 + x.size // hop
+    padded = np.concatenate([np.zeros(n_fft // 2, np.float32), x,
+                             np.zeros(n_fft // 2 + hop, np.float32)])
+    blocks = []
+    for first in range(0, n_frames, _BLOCK_FRAMES):
+        count = min(_BLOCK_FRAMES, n_frames - first)
+        chunk = padded[first * hop:first * hop + (count - 1) * hop + n_fft]
+        blocks.append(librosa.feature.mfcc(y=chunk, sr=ALIGN_RATE, n_mfcc=_N_MFCC, n_fft=n_fft,
+                                           win_length=400, hop_length=hop, n_mels=40,
+                                           center=False)[1:, :count])
+    mfcc = np.concatenate(blocks, axis=1)
     mfcc -= mfcc.mean(axis=1, keepdims=True)
     mfcc /= mfcc.std(axis=1, keepdims=True) + 1e-6
     return np.ascontiguousarray(mfcc.T, dtype=np.float32)
@@ -105,16 +119,52 @@ def align_dtw(
     the audio, ``source="dtw"``, ``alphabet="ipa"``. Raises SpeechError for unreadable or
     silent audio or a transcript without words; MissingExtraError without the speech extra.
     """
-    if not isinstance(text, str) or not text.strip():
-        raise SpeechError(f"transcript {text!r} has no words")
-    rec_samples = load_speech(audio, sample_rate=sample_rate)
-    rec = mfcc_features(rec_samples)
-    duration_ms = round(rec_samples.size * 1000 / ALIGN_RATE)
-    del rec_samples
+    samples = load_speech(audio, sample_rate=sample_rate)
+    duration_ms = round(samples.size * 1000 / ALIGN_RATE)
+    where = None if isinstance(audio, np.ndarray) else audio
     phones: list[Span] = []
     words: list[Span] = []
+    by_sentence = duration_ms > _WHOLE_MAX_S * 1000
+    for _, syn, to_rec_ms in _warped(samples, text, lang=lang, voice=voice,
+                                       by_sentence=by_sentence, where=where):
+        for span in syn.timeline.phones:
+            _extend(phones, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+        for span in syn.timeline.words:
+            _extend(words, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+    return PhoneTimeline(_cover(phones, duration_ms), _cover(words, duration_ms), "dtw",
+                         duration_ms, alphabet="ipa")
+
+
+def sentence_spans(
+    samples: np.ndarray, text: str, *, lang: str = DEFAULT_LANGUAGE, voice: str | None = None,
+) -> list[Span]:
+    """Where each sentence of ``text`` is spoken in ``samples`` (``(n,) float32`` at 16 kHz):
+    spans labelled with the sentence, from its first sound to its last (ms), found by DTW
+    sentence by sentence (bounded memory). Used to cut long recordings into utterances."""
+    out = []
+    for sentence, syn, to_rec_ms in _warped(samples, text, lang=lang, voice=voice,
+                                              by_sentence=True, where=None):
+        sounds = [p for p in syn.timeline.phones if p.label != SILENCE]
+        if not sounds:
+            continue
+        start, end = to_rec_ms(sounds[0].start_ms), to_rec_ms(sounds[-1].end_ms)
+        if out:
+            start = max(start, out[-1].end_ms)
+        out.append(Span(sentence, start, max(start, end)))
+    return out
+
+
+def _warped(
+    samples: np.ndarray, text: str, *, lang: str, voice: str | None, by_sentence: bool,
+    where: str | Path | None,
+) -> Iterator[tuple[str, Synthesis, Callable[[int], int]]]:
+    """For each sentence (or the whole ``text``): the sentence, its synthesis, and the map
+    from its synthesized time (ms) to recording time (ms)."""
+    if not isinstance(text, str) or not text.strip():
+        raise SpeechError(f"transcript {text!r} has no words")
+    rec = mfcc_features(samples)
     cursor = 0
-    parts = _sentences(text) if duration_ms > _WHOLE_MAX_S * 1000 else [text]
+    parts = _sentences(text) if by_sentence else [text]
     spoken = synthesize_many(parts, lang=lang, voice=voice)
     for k, (sentence, syn) in enumerate(zip(parts, spoken, strict=True)):
         feats = mfcc_features(_to_align_rate(np.asarray(syn.samples), syn.sample_rate))
@@ -126,7 +176,7 @@ def align_dtw(
             window = rec[cursor:cursor + size]
         if len(window) < 2:
             raise SpeechError(f"the recording ends before the sentence {sentence[:40]!r}",
-                              path=None if isinstance(audio, np.ndarray) else audio)
+                              path=where)
         mapped = _warp(feats, window, open_end=not last)
         offset = cursor
 
@@ -134,13 +184,8 @@ def align_dtw(
             i = min(round(ms / HOP_MS), len(mapped) - 1)
             return round(float(mapped[i] + offset) * HOP_MS)
 
-        for span in syn.timeline.phones:
-            _extend(phones, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
-        for span in syn.timeline.words:
-            _extend(words, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+        yield sentence, syn, to_rec_ms
         cursor = offset + int(np.ceil(mapped[-1]))
-    return PhoneTimeline(_cover(phones, duration_ms), _cover(words, duration_ms), "dtw",
-                         duration_ms, alphabet="ipa")
 
 
 def _extend(spans: list[Span], label: str, start: int, end: int) -> None:
