@@ -118,28 +118,31 @@ def synthesize_many(
     voice: str | None = None,
     rate: float = 1.0,
     pitch: float = 50,
+    voices: Sequence[str] | None = None,
 ) -> list[Synthesis]:
     """:func:`synthesize` of each of ``texts`` (same options), in one fresh espeak-ng
     process (:func:`facelib.speech.espeak.synth_fresh`): the result depends only on the
-    arguments, bit for bit."""
+    arguments, bit for bit. ``voices`` gives each text its own voice (overrides ``voice``)."""
     for text in texts:
         if not isinstance(text, str) or not text.strip():
             raise ParameterError(f"text to speak must be a non-empty string, got {text!r}")
     rate = check_number("speaking rate", rate, low=0.5, high=2.5)
     pitch = check_number("pitch", pitch, low=0, high=100)
-    chosen = voice or voice_for(lang)
+    chosen = list(voices) if voices is not None else [voice or voice_for(lang)] * len(texts)
+    if len(chosen) != len(texts):
+        raise ParameterError(f"{len(chosen)} voices for {len(texts)} texts")
     wpm = round(min(max(rate * default_words_per_minute(), _MIN_WPM), _MAX_WPM))
     spoken = [spell_numbers(text, lang=lang) for text in texts]
-    raws = synth_fresh([(s, chosen, wpm, round(pitch)) for s in spoken])
+    raws = synth_fresh([(s, v, wpm, round(pitch)) for s, v in zip(spoken, chosen, strict=True)])
     out = []
-    for text, said, raw in zip(texts, spoken, raws, strict=True):
+    for text, said, raw, who in zip(texts, spoken, raws, chosen, strict=True):
         if raw.samples.size == 0 or not any(e.kind == "phone" and e.name for e in raw.events):
-            raise SpeechError(f"espeak-ng spoke nothing for {text[:60]!r} (voice {chosen!r})")
+            raise SpeechError(f"espeak-ng spoke nothing for {text[:60]!r} (voice {who!r})")
         samples = raw.samples.astype(np.float32) / 32768.0
         samples.flags.writeable = False
         timeline = events_to_timeline(raw.events, said, n_samples=raw.samples.size,
                                       sample_rate=raw.sample_rate)
-        out.append(Synthesis(samples, raw.sample_rate, timeline, said, chosen))
+        out.append(Synthesis(samples, raw.sample_rate, timeline, said, who))
     return out
 
 
