@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from facelib.checks import check_fps
-from facelib.cues import SpeechSpec
+from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
 from facelib.errors import MissingExtraError, SpeechError, SpeechWarning
 from facelib.mpeg4.track import FapTrack
 from facelib.speech import align as align_phones
@@ -127,6 +127,10 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
             raise SpeechError(f"{exc.message} (speech of {speech.origin[0]}:"
                               f"{speech.origin[1]})", path=exc.path) from exc
     if speech.text:
+        if len(speech.text) > MAX_SPEECH_TEXT_CHARS:
+            path, line = speech.origin if speech.origin else (None, None)
+            raise SpeechError(f"speech text has {len(speech.text)} characters, more than "
+                              f"{MAX_SPEECH_TEXT_CHARS}", path=path, line=line)
         try:
             made = synthesize_speech(speech.text, lang=lang, voice=speech.voice,
                               rate=min(max(speech.rate * rate, 0.5), 2.5), pitch=speech.pitch)
@@ -159,19 +163,24 @@ def _recorded(audio: Path, text: str | None, lang: str, voice: str | None) -> Ph
 
 
 def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
-            language: str | None = None) -> VisemeAnimation:
+            language: str | None = None, max_frames: int = MAX_FRAMES) -> VisemeAnimation:
     """Mouth, jaw and tongue FAP curves for ``speech``.
 
     Frame i of the track is at ``i / fps`` s of the storyboard; the track ends at the last
     frame inside the speech. Values come from the coarticulation blend of the viseme
     targets; weights are the speech envelope on the driven FAPs (0 elsewhere).
     ``rate`` multiplies the speech's own speaking rate; ``language`` is the storyboard's.
+    Speech longer than ``max_frames`` raises SpeechError before the curves are computed.
     """
     fps = check_fps(fps)
     own, audio = _spoken(speech, rate=rate, language=language)
     timeline = own.shifted(speech.start_ms)
     end_ms = speech.start_ms + timeline.duration_ms
     n_frames = math.floor(end_ms * fps / 1000) + 1
+    if n_frames > max_frames:
+        path, line = speech.origin if speech.origin else (None, None)
+        raise SpeechError(f"speech lasts {end_ms} ms = {n_frames} frames at {fps:g} fps, more "
+                          f"than max_frames={max_frames}", path=path, line=line)
     times = frame_times_ms(n_frames, fps)
     values = blend(timeline.visemes, times)
     weight = np.zeros_like(values)
