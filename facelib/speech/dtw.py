@@ -166,7 +166,7 @@ def sentence_spans(
     """Where each sentence of ``text`` is spoken in ``samples`` (``(n,) float32`` at 16 kHz):
     spans labelled with the sentence, from its first sound to its last (ms), found by DTW
     sentence by sentence (bounded memory). Used to cut long recordings into utterances."""
-    out = []
+    out: list[Span] = []
     for sentence, syn, to_rec_ms in _warped(samples, text, lang=lang, voice=voice,
                                               by_sentence=True, where=None):
         sounds = [p for p in syn.timeline.phones if p.label != SILENCE]
