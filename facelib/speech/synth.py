@@ -9,6 +9,7 @@ so the phone times are those of the samples returned, to the sample.
 from __future__ import annotations
 
 import re
+from bisect import bisect_left
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
@@ -163,15 +164,17 @@ def events_to_timeline(
         _add(phones, _STRESS.sub("", e.name) or SILENCE, ms(e.sample), ms(end))
     duration = ms(n_samples)
     phones = _covered(phones, duration)
+    starts = [p.start_ms for p in phones]
     words: list[Span] = []
     word_events = [e for e in events if e.kind == "word"]
     for k, w in enumerate(word_events):
         start = ms(w.sample)
         end = ms(word_events[k + 1].sample) if k + 1 < len(word_events) else duration
         # the word ends where its trailing pause (if any) begins
-        inside = [p for p in phones if start <= p.start_ms < end]
-        while inside and inside[-1].label == SILENCE:
-            end = inside.pop().start_ms
+        k_end = bisect_left(starts, end)
+        while k_end > 0 and starts[k_end - 1] >= start and phones[k_end - 1].label == SILENCE:
+            k_end -= 1
+            end = phones[k_end].start_ms
         if words and words[-1].start_ms == start:  # espeak expanded one token to many
             continue
         label = text[w.text_position - 1:w.text_position - 1 + w.length].strip().lower()

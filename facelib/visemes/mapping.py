@@ -80,18 +80,20 @@ def enforce_min_duration(
     bilabial (p b m), whose closure must show: its neighbour gives way instead."""
     min_len = timing_rules()["min_visible_ms"] if min_ms is None else min_ms
     out = list(visemes)
-    changed = True
-    while changed:
-        changed = False
-        for i, span in enumerate(out):
-            need = min_len - span.duration_ms
-            if need <= 0 or len(out) == 1:
-                continue
-            need = _borrow(out, i, need, min_len)
-            if need > 0:
-                _merge(out, i)
-            changed = True
-            break
+    # Fix the first span that is too short, then look again from just before it: a fix
+    # only touches that span and its neighbours, and never makes an earlier span too short
+    # (neighbours lend only what they can spare), so spans further back stay fixed. Linear
+    # in the number of spans, where restarting from the first span was quadratic.
+    i = 0
+    while i < len(out):
+        need = min_len - out[i].duration_ms
+        if need <= 0 or len(out) == 1:
+            i += 1
+            continue
+        need = _borrow(out, i, need, min_len)
+        if need > 0:
+            _merge(out, i)
+        i = max(i - 2, 0)
     return tuple(out)
 
 
