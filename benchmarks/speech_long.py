@@ -8,6 +8,7 @@ transcript. Usage::
 
     PYTHONPATH=. .venv/bin/python benchmarks/speech_long.py            # 1 and 5 minutes
     PYTHONPATH=. .venv/bin/python benchmarks/speech_long.py 1 5 20     # any lengths
+    PYTHONPATH=. .venv/bin/python benchmarks/speech_long.py --text-only 1 5 20
 
 Prints one line per run: minutes, mode, peak MB, seconds, seconds per minute of speech.
 """
@@ -61,7 +62,7 @@ def measure(story: Path, out: Path) -> tuple[float, float]:
     return peak_kb / 1024, seconds
 
 
-def main(lengths: list[float]) -> None:
+def main(lengths: list[float], *, text_only: bool = False) -> None:
     print("minutes  mode        speech_s  peak_MB  seconds  s_per_speech_min")
     with tempfile.TemporaryDirectory() as folder:
         base = Path(folder)
@@ -77,6 +78,8 @@ def main(lengths: list[float]) -> None:
                 "text-only": 'say { transcript = "text.txt" }\n',
                 "recording": 'say { audio = "speech.wav", transcript = "text.txt" }\n',
             }
+            if text_only:
+                del stories["recording"]
             for mode, body in stories.items():
                 story = base / f"{mode}.fdl"
                 story.write_text(body, encoding="utf-8")
@@ -87,4 +90,5 @@ def main(lengths: list[float]) -> None:
 
 
 if __name__ == "__main__":
-    main([float(a) for a in sys.argv[1:]] or [1.0, 5.0])
+    args = [a for a in sys.argv[1:] if a != "--text-only"]
+    main([float(a) for a in args] or [1.0, 5.0], text_only="--text-only" in sys.argv)
