@@ -25,6 +25,7 @@ Each clip is made in a hidden temporary folder and renamed into place when compl
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -32,7 +33,7 @@ import shutil
 import tempfile
 import time
 import tomllib
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -247,15 +248,17 @@ class DatasetReport:
 
 
 def _with_head(stream: Any, head_deg: Sequence[float]) -> Any:
-    """``stream`` with the head pose offset added to FAPs 48-50 in every frame."""
+    """``stream`` with the head pose offset added to FAPs 48-50 in every frame, rounded to
+    whole FAP units as ``clip.fap`` stores them, so the frames show exactly that file (and
+    last-bit differences of floating point between machines cannot reach the pixels)."""
     from facelib.mpeg4 import FapStream
 
-    values = np.array(stream.values)
+    values = np.array(stream.values, np.float64)
     mask = np.array(stream.mask)
     for fap_id, degrees in zip(_HEAD_FAPS, head_deg, strict=True):
-        values[:, fap_id - 1] += np.float32(degrees * _AU_PER_DEG)
+        values[:, fap_id - 1] += degrees * _AU_PER_DEG
         mask[:, fap_id - 1] = True
-    return FapStream(stream.fps, values, mask, stream.viseme, stream.expression)
+    return FapStream(stream.fps, np.rint(values), mask, stream.viseme, stream.expression)
 
 
 def _framing(face: Any, zoom: float, shift: Sequence[float]) -> np.ndarray:
@@ -370,21 +373,36 @@ def _clip_task(spec: DatasetSpec, index: int, out_dir: str) -> tuple[int, str, s
         return index, "failed", f"{type(exc).__name__}: {exc}"
 
 
+# Dask's nanny starts workers with these at 1; the local pool does the same, so dense
+# products sum in the same order (and the pixels match to the bit) either way.
+_ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _environment(values: Mapping[str, str]) -> Iterator[None]:
+    """``os.environ`` updated with ``values`` inside (for the processes started there)."""
+    saved = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
 def _run_local(spec: DatasetSpec, todo: Sequence[int], out_dir: str, jobs: int,
                report: ProgressCallback | None) -> list[tuple[int, str, str | None]]:
-    """The clips ``todo`` on ``jobs`` spawned worker processes (or in this one for 1)."""
+    """The clips ``todo`` on ``jobs`` spawned worker processes, one BLAS thread each."""
     import multiprocessing
 
     from facelib.batch import _raise_on_sigterm
 
     results: list[tuple[int, str, str | None]] = []
-    if jobs == 1:
-        for index in todo:
-            results.append(_clip_task(spec, index, out_dir))
-            if report is not None:
-                report(len(results), len(todo))
-        return results
-    pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_raise_on_sigterm)
+    with _environment(_ONE_THREAD):
+        pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_raise_on_sigterm)
     try:
         tasks = [(spec, i, out_dir) for i in todo]
         for result in pool.imap_unordered(_star_clip_task, tasks):
