@@ -9,18 +9,21 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
 
 import numpy as np
 
 from facelib import expressions, gaze, visemes
-from facelib.cues import Storyboard
-from facelib.errors import FacelibError
+from facelib.checks import check_seed
+from facelib.cues import MAX_FRAMES, Storyboard
+from facelib.errors import FacelibError, ParameterError
 from facelib.fdl import load
+from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.progress import ProgressCallback, progress_callback
 from facelib.sync import SyncRules, combine
+from facelib.visemes.animate import VisemeAnimation
+from facelib.visemes.timeline import VisemeSpan
 
 __all__ = ["Animation", "animate", "definition_line", "run_fdl"]
 
@@ -44,8 +47,8 @@ class Animation:
     storyboard: Storyboard
     audio_offset: float = 0.0
     tracks: Mapping[str, FapTrack] = field(default_factory=dict)
-    visemes: Any = None
-    gaze_events: Any = ()
+    visemes: tuple[VisemeSpan, ...] | None = None
+    gaze_events: tuple[GazeEvent, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "tracks", MappingProxyType(dict(self.tracks)))
@@ -66,6 +69,7 @@ _STAGES = 4  # speech, expressions, gaze, synchronizer: the units of animate's p
 
 def animate(
     storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
+    max_frames: int = MAX_FRAMES,
     progress: bool | ProgressCallback | None = None,
 ) -> Animation:
     """Run the generators of a storyboard and resolve their conflicts.
@@ -73,13 +77,15 @@ def animate(
     seed: overrides ``storyboard.seed``; the same storyboard and seed give the same stream
     bit for bit. rules: the synchronizer's weights (default ``facelib/data/sync.json``).
     The stream lasts as long as the longest track: the speech, or the last cue including a
-    frame at its very end. ``progress`` (see :mod:`facelib.progress`) is called after each
+    frame at its very end. ``max_frames`` bounds its length (default
+    :data:`facelib.cues.MAX_FRAMES`); a longer storyboard raises ParameterError before
+    anything is computed. ``progress`` (see :mod:`facelib.progress`) is called after each
     of the four stages (speech, expressions, gaze, synchronizer) as ``progress(done, 4)``.
     An error of a generator that names no file is raised again naming the storyboard (and
     the line of the definition it concerns, where one can be found).
     """
     try:
-        return _animate(storyboard, seed=seed, rules=rules,
+        return _animate(storyboard, seed=seed, rules=rules, max_frames=max_frames,
                         report=progress_callback(progress, "animating", unit="stages"))
     except FacelibError as exc:
         if exc.path is not None or storyboard.path is None:
@@ -89,7 +95,7 @@ def animate(
 
 
 def _animate(
-    storyboard: Storyboard, *, seed: int | None, rules: SyncRules | None,
+    storyboard: Storyboard, *, seed: int | None, rules: SyncRules | None, max_frames: int,
     report: ProgressCallback | None,
 ) -> Animation:
     def step(done: int) -> None:
@@ -97,12 +103,18 @@ def _animate(
             report(done, _STAGES)
 
     if seed is not None:
-        storyboard = replace(storyboard, seed=int(seed))
+        storyboard = replace(storyboard, seed=check_seed(seed))
     rules = rules or SyncRules.load()
     fps = storyboard.fps
-    speech = visemes.animate(storyboard.speech, fps=fps) if storyboard.speech else None
     # one frame past the last cue's end, so the face is shown settling back to neutral
     n_frames = math.floor(storyboard.cues_end_ms * fps / 1000 + 1e-9) + 1
+    if n_frames > max_frames:
+        raise ParameterError(
+            f"storyboard {storyboard.path or '(in memory)'} lasts {storyboard.cues_end_ms} ms "
+            f"= {n_frames} frames at {fps:g} fps, more than max_frames={max_frames}"
+        )
+    speech = (visemes.animate(storyboard.speech, fps=fps, max_frames=max_frames)
+              if storyboard.speech else None)
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
     speaking = np.zeros(n_frames, bool)
@@ -137,10 +149,10 @@ def _animate(
     )
 
 
-def _with_importance(speech: Any, rules: SyncRules) -> FapTrack:
+def _with_importance(speech: VisemeAnimation, rules: SyncRules) -> FapTrack:
     """The viseme track with each viseme's importance (``rules.viseme_importance``) on its
     weight, frame by frame along the timeline."""
-    track: FapTrack = speech.track
+    track = speech.track
     if not rules.viseme_importance:
         return track
     factor = np.ones(track.n_frames, np.float32)

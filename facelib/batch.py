@@ -79,7 +79,8 @@ def render_job(job: RenderJob) -> BatchResult:
     except Exception as exc:  # a bug or an environment failure: report it, keep going  # noqa: BLE001
         return BatchResult(job.source, None, time.perf_counter() - started,
                            f"{type(exc).__name__}: {exc}")
-    return BatchResult(job.source, Path(out), time.perf_counter() - started)
+    assert isinstance(out, Path), "render with out= returns the path written"
+    return BatchResult(job.source, out, time.perf_counter() - started)
 
 
 def _raise_on_sigterm() -> None:

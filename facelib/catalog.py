@@ -7,6 +7,7 @@ eye behaviours from ``facelib/data/gaze/behaviours.json``, visemes from the MPEG
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 
@@ -34,8 +35,10 @@ def catalog(kind: str) -> tuple[Entry, ...]:
     """The entries of ``kind``, one of :data:`KINDS`, in library order."""
     if kind not in KINDS:
         raise FacelibError(f"unknown kind {kind!r}; choose one of {', '.join(KINDS)}")
-    return {"expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
-            "voices": _voices}[kind]()
+    listers: dict[str, Callable[[], tuple[Entry, ...]]] = {
+        "expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
+        "voices": _voices}
+    return listers[kind]()
 
 
 @cache

@@ -55,6 +55,9 @@ _HEAD_FAPS = (48, 49, 50)
 _AU_PER_DEG = math.pi / 180 * 1e5
 
 
+_DEFAULT_HEAD_DEG = ((-8.0, 8.0), (-15.0, 15.0), (-5.0, 5.0))
+"""Pitch, yaw and roll ranges of the head in degrees unless a spec says otherwise."""
+
 @dataclass(frozen=True)
 class DatasetSpec:
     """What to generate. Ranges are ``(low, high)`` drawn uniformly.
@@ -81,7 +84,7 @@ class DatasetSpec:
     expressions_per_clip: tuple[int, int] = (1, 2)
     intensity: tuple[float, float] = (0.5, 1.0)
     behaviours: tuple[str, ...] = ("default",)
-    head_deg: tuple[tuple[float, float], ...] = ((-8.0, 8.0), (-15.0, 15.0), (-5.0, 5.0))
+    head_deg: tuple[tuple[float, float], ...] = _DEFAULT_HEAD_DEG
     texts: tuple[str, ...] = ()
     speech_probability: float = 0.5
     zoom: tuple[float, float] = (0.9, 1.2)
@@ -158,7 +161,7 @@ def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
     options["head_deg"] = tuple(
         _pair(head[k], f"head.{k}", where) if k in head else default
         for k, default in zip(("pitch_deg", "yaw_deg", "roll_deg"),
-                              DatasetSpec.__dataclass_fields__["head_deg"].default,
+                              _DEFAULT_HEAD_DEG,
                               strict=True))
     speech = raw.get("speech", {})
     if "texts" in speech:

@@ -16,11 +16,15 @@ __all__ = [
     "FacelibWarning",
     "FapFormatError",
     "FdlError",
+    "FdlWarning",
+    "FileError",
     "MissingExtraError",
     "ParameterError",
     "RenderError",
     "SpeechError",
     "SpeechWarning",
+    "TrackingError",
+    "TrackingWarning",
 ]
 
 
@@ -78,6 +82,21 @@ class RenderError(FacelibError):
     """Rendering or video encoding failed (no OpenGL platform, encoder error, ...)."""
 
 
+class TrackingError(FacelibError):
+    """A video or landmark track cannot be turned into FAPs (no face, unreadable video,
+    wrong point count, missing feature points); the message names the frames."""
+class FileError(FacelibError, OSError):
+    """A file or folder could not be read or written: the operating system's error
+    (``OSError``, kept as ``__cause__``) with the path it concerns."""
+
+    @classmethod
+    def wrap(cls, exc: OSError, what: str, path: str | Path) -> FileError:
+        """``FileError`` for ``exc`` raised while doing ``what`` ("write", "read") at
+        ``path``."""
+        reason = exc.strerror or str(exc)
+        return cls(f"cannot {what}: {reason}", path=path)
+
+
 class MissingExtraError(FacelibError, ImportError):
     """An optional dependency is needed for this feature but is not installed."""
 
@@ -92,5 +111,14 @@ class FacelibWarning(UserWarning):
     """Something was accepted but looked irregular (e.g. frames missing from a ``.fap``)."""
 
 
+class FdlWarning(FacelibWarning):
+    """A storyboard ran but something in it looks like a mistake (a global that is no
+    setting but close to one, ``fsp = 30``), named with its file and line."""
+
+
 class SpeechWarning(FacelibWarning):
     """An alignment succeeded but looks implausible (named word, reason)."""
+
+
+class TrackingWarning(FacelibWarning):
+    """Tracking went on but lost the face in some frames, or saw several faces (names them)."""

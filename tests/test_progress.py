@@ -15,7 +15,7 @@ from facelib.errors import ParameterError
 from facelib.progress import ConsoleProgress, progress_callback
 
 ROOT = Path(__file__).resolve().parents[1]
-SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
+SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 
 
 def test_lines_every_tenth_when_not_a_terminal():
@@ -26,7 +26,7 @@ def test_lines_every_tenth_when_not_a_terminal():
     lines = out.getvalue().splitlines()
     assert [line.split(":")[1].split("%")[0].strip() for line in lines] == [
         str(p) for p in range(0, 101, 10)]  # 0 %: the job has started
-    assert lines[3].startswith("rendering: 40% (48/120 frames, ")
+    assert lines[4].startswith("rendering: 40% (48/120 frames, ")
 
 
 def test_a_bar_redrawn_in_place_on_a_terminal():

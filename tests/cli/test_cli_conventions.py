@@ -17,7 +17,7 @@ from facelib import read_fap
 from facelib.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
+SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 HAS_RENDER = importlib.util.find_spec("pyrender") is not None
 
 
