@@ -129,16 +129,32 @@ _SECTIONS = {
 }
 
 
-def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
-    """Read a dataset spec (TOML); unknown keys and bad values raise FacelibError naming
-    the file."""
+# (section, key in the TOML) -> (DatasetSpec field, how its value is read)
+_RANGE = "range"
+_FIELDS: dict[tuple[str, str], tuple[str, str]] = {
+    ("expressions", "names"): ("expressions", "names"),
+    ("expressions", "per_clip"): ("expressions_per_clip", "counts"),
+    ("expressions", "intensity"): ("intensity", _RANGE),
+    ("gaze", "behaviours"): ("behaviours", "names"),
+    ("speech", "texts"): ("texts", "names"),
+    ("speech", "probability"): ("speech_probability", "number"),
+    ("camera", "zoom"): ("zoom", _RANGE),
+    ("camera", "shift"): ("shift", _RANGE),
+}
+
+
+def _read_toml(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
     where = str(path)
     try:
-        raw = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        text = Path(path).read_text(encoding="utf-8")
+        return tomllib.loads(text), text
     except OSError as exc:
         raise FacelibError(f"cannot read the dataset spec ({exc.strerror})", path=where) from None
     except tomllib.TOMLDecodeError as exc:
         raise FacelibError(f"not valid TOML: {exc}", path=where) from None
+
+
+def _check_keys(raw: Mapping[str, Any], where: str) -> None:
     for key, value in raw.items():
         allowed = _SECTIONS.get(key)
         if allowed is None and key not in _TOP_KEYS:
@@ -146,34 +162,38 @@ def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
                                f"{sorted(_TOP_KEYS | set(_SECTIONS))}", path=where)
         if allowed is not None and (not isinstance(value, dict) or set(value) - allowed):
             raise FacelibError(f"[{key}] takes {sorted(allowed)}, got {value!r}", path=where)
+
+
+def _convert(value: Any, kind: str, name: str, where: str) -> Any:
+    if kind == _RANGE:
+        return _pair(value, name, where)
+    if kind == "counts":
+        low, high = _pair(value, name, where)
+        return int(low), int(high)
+    if kind == "names":
+        if not isinstance(value, list):
+            raise FacelibError(f"{name} must be a list, got {value!r}", path=where)
+        return tuple(str(v) for v in value)
+    return value
+
+
+def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
+    """Read a dataset spec (TOML, see ``docs/batch.md``); unknown keys and bad values raise
+    FacelibError naming the file."""
+    where = str(path)
+    raw, text = _read_toml(path)
+    _check_keys(raw, where)
     options: dict[str, Any] = {k: raw[k] for k in _TOP_KEYS if k in raw}
-    expressions = raw.get("expressions", {})
-    if "names" in expressions:
-        options["expressions"] = tuple(expressions["names"])
-    if "per_clip" in expressions:
-        low, high = _pair(expressions["per_clip"], "expressions.per_clip", where)
-        options["expressions_per_clip"] = (int(low), int(high))
-    if "intensity" in expressions:
-        options["intensity"] = _pair(expressions["intensity"], "expressions.intensity", where)
-    if "behaviours" in raw.get("gaze", {}):
-        options["behaviours"] = tuple(raw["gaze"]["behaviours"])
+    for (section, key), (field_name, kind) in _FIELDS.items():
+        if key in raw.get(section, {}):
+            options[field_name] = _convert(raw[section][key], kind, f"{section}.{key}", where)
     head = raw.get("head", {})
     options["head_deg"] = tuple(
         _pair(head[k], f"head.{k}", where) if k in head else default
-        for k, default in zip(("pitch_deg", "yaw_deg", "roll_deg"),
-                              _DEFAULT_HEAD_DEG,
+        for k, default in zip(("pitch_deg", "yaw_deg", "roll_deg"), _DEFAULT_HEAD_DEG,
                               strict=True))
-    speech = raw.get("speech", {})
-    if "texts" in speech:
-        options["texts"] = tuple(str(t) for t in speech["texts"])
-    if "probability" in speech:
-        options["speech_probability"] = speech["probability"]
-    camera = raw.get("camera", {})
-    for key in ("zoom", "shift"):
-        if key in camera:
-            options[key] = _pair(camera[key], f"camera.{key}", where)
     try:
-        return DatasetSpec(**options, source=Path(path).read_text(encoding="utf-8"))
+        return DatasetSpec(**options, source=text)
     except (ParameterError, TypeError) as exc:
         raise FacelibError(str(exc), path=where) from None
 

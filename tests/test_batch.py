@@ -13,7 +13,7 @@ from facelib.cli import main
 from facelib.errors import ParameterError
 
 ROOT = Path(__file__).resolve().parents[1]
-SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
+SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 SMILE = ROOT / "examples" / "fap" / "xface_smile.fap"
 
 pytestmark = [pytest.mark.render, pytest.mark.skipif(
