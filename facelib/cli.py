@@ -205,8 +205,10 @@ def _check(args: argparse.Namespace, console: Console) -> int:
     storyboard = load(args.story, seed=args.seed)
     animation = animate(storyboard, seed=args.seed)  # what run rejects, check rejects
     print(describe(storyboard))
+    target = _default_output(args.story, storyboard.output, ".fap")
     console.status(f"ok: {animation.faps.n_frames} frames at {animation.faps.fps:g} fps "
-                   f"({animation.faps.duration:.2f} s)")
+                   f"({animation.faps.duration:.2f} s); 'facelib run' without -o writes "
+                   f"{target}")
     return EXIT_OK
 
 
