@@ -42,11 +42,17 @@ _LAZY = {
     "save_png": "facelib.rendering.frames",
     "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
+    "export_gltf": "facelib.export",
+    "export_html": "facelib.export",
+    "export_arkit": "facelib.export",
+    "import_arkit": "facelib.export",
+    "to_arkit": "facelib.export",
+    "from_arkit": "facelib.export",
 }
 
 
 def __getattr__(name: str) -> Any:
-    """Rendering, the viewer and plotting import OpenGL or matplotlib: load them on use."""
+    """Rendering, the viewer, plotting and the exports load on first use."""
     if name in _LAZY:
         import importlib
 
@@ -74,11 +80,16 @@ __all__ = [
     "SpeechWarning",
     "__version__",
     "animate",
+    "export_arkit",
+    "export_gltf",
+    "export_html",
     "expressions",
     "fap",
     "fdl",
     "feature_point",
+    "from_arkit",
     "gaze",
+    "import_arkit",
     "load_face",
     "mpeg4",
     "plot_curves",
@@ -88,6 +99,7 @@ __all__ = [
     "run_fdl",
     "save_png",
     "sync",
+    "to_arkit",
     "view",
     "visemes",
     "write_fap",

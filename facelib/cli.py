@@ -618,6 +618,83 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     return EXIT_OK
 
 
+# -- export and import-arkit -------------------------------------------------------------
+
+
+def _add_export(commands: Any) -> None:
+    export = commands.add_parser(
+        "export", parents=[_COMMON],
+        help="export to glTF (.glb), ARKit curves (.csv/.json) or a web page")
+    export.add_argument("source", help="STORY.fdl or FILE.fap")
+    export.add_argument("-o", "--output",
+                        help="OUT.glb (glTF), or with --arkit OUT.csv (Live Link Face) / OUT.json")
+    export.add_argument("--arkit", action="store_true",
+                        help="write ARKit-52 blendshape curves instead of glTF")
+    export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
+    export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
+    export.add_argument("--seed", type=int)
+    export.set_defaults(run=_export)
+
+    imp = commands.add_parser(
+        "import-arkit", parents=[_COMMON],
+        help="turn an ARKit capture (Live Link Face CSV) into a .fap")
+    imp.add_argument("capture", help="the Live Link Face .csv (or facelib's ARKit .json)")
+    imp.add_argument("-o", "--output", required=True, help="OUT.fap, or - for stdout")
+    imp.add_argument("--fps", type=float,
+                     help="timecode rate of the capture (default: read from the timecodes)")
+    imp.add_argument("--resample", type=float, help="resample to this frame rate (e.g. 25)")
+    imp.add_argument("--dialect", default="standard",
+                     choices=("standard", "xface", "greta", "extended"))
+    imp.set_defaults(run=_import_arkit)
+
+
+def _export(args: argparse.Namespace, console: Console) -> int:
+    import numpy as np
+
+    from facelib import export
+    from facelib.engine import default_face, load_face
+
+    if args.output is None and args.html is None:
+        raise UsageError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
+                         "or both")
+    if args.output is not None:
+        _check_suffix(args.output, (".csv", ".json") if args.arkit else
+                      (".glb", ".csv", ".json"), "export")
+    face = default_face() if args.face is None else load_face(args.face)
+    source = _source(args.source, args.seed, console)
+    if args.output is not None:
+        suffix = Path(args.output).suffix.lower()
+        if args.arkit or suffix in (".csv", ".json"):
+            curves = export.export_arkit(source, args.output, face=face)
+            moving = curves.relative[curves.relative > 0]
+            fit = (f"; fit residual RMS {1000 * float(curves.residual.mean()):.2f} mm, "
+                   f"median relative {float(np.median(moving)):.2f}" if moving.size else "")
+            console.status(f"wrote {args.output} ({curves.n_frames} frames of 52 ARKit "
+                           f"weights{fit})")
+        else:
+            result = export.export_gltf(source, args.output, face=face, audio=args.audio)
+            audio = f", audio {result.audio}" if result.audio else ""
+            console.status(f"wrote {result.path} ({len(result.targets)} morph targets, "
+                           f"{result.n_frames} frames{audio})")
+    if args.html is not None:
+        page = export.export_html(source, args.html, face=face, audio=args.audio)
+        console.status(f"wrote {page.page} (open it in a browser)")
+    return EXIT_OK
+
+
+def _import_arkit(args: argparse.Namespace, console: Console) -> int:
+    from facelib.export import import_arkit
+
+    _check_suffix(args.output, (".fap",), "import-arkit")
+    stream = import_arkit(args.capture, fps=args.fps)
+    if args.resample is not None:
+        stream = stream.resample(args.resample)
+    _emit_text(format_fap(stream, dialect=args.dialect, name=Path(args.capture).stem),
+               args.output, console, f"({stream.n_frames} frames, {stream.duration:.2f} s)")
+    return EXIT_OK
+
+
 _COMMON = argparse.ArgumentParser(add_help=False)
 _COMMON.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
                      help="print only errors")
@@ -626,7 +703,7 @@ _COMMON.add_argument("-v", "--verbose", action="store_true", default=argparse.SU
 
 _COMMANDS: tuple[Callable[[Any], None], ...] = (
     _add_info, _add_check, _add_run, _add_render, _add_view, _add_plot, _add_align,
-    _add_list, _add_dataset, _add_evaluate, _add_track,
+    _add_list, _add_dataset, _add_evaluate, _add_track, _add_export,
 )
 
 
