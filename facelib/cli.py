@@ -749,6 +749,15 @@ def _stdout_gone() -> int:
     return EXIT_PIPE
 
 
+def _stopped(signum: int) -> int:
+    """One line and the exit status for a command stopped by ``signum``."""
+    if signum == signal.SIGINT:
+        print("facelib: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print("facelib: terminated", file=sys.stderr)
+    return EXIT_TERMINATED
+
+
 def _dispatch(run: Callable[[argparse.Namespace, Console], int], args: argparse.Namespace,
               console: Console) -> int:
     try:
@@ -759,12 +768,12 @@ def _dispatch(run: Callable[[argparse.Namespace, Console], int], args: argparse.
     except BrokenPipeError:
         return _stdout_gone()
     except KeyboardInterrupt:
-        print("facelib: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _stopped(signal.SIGINT)
     except Terminated:
-        print("facelib: terminated", file=sys.stderr)
-        return EXIT_TERMINATED
+        return _stopped(signal.SIGTERM)
     except FacelibError as exc:
+        if console.signals.received is not None:  # a library turned the signal into an error
+            return _stopped(console.signals.received)
         if console.verbose:
             traceback.print_exc()
         print(f"facelib: error: {exc}", file=sys.stderr)
