@@ -57,7 +57,7 @@ def test_xface_groups_warn_and_standard_does_not(tmp_path):
     mask = np.zeros((2, 84), bool)
     mask[:, :3] = True
     stream = FapStream(25, values, mask, np.array([[1, 2, 30, 0]] * 2), None)
-    with pytest.warns(FacelibWarning, match="Greta's Java reader and VREng"):
+    with pytest.warns(FacelibWarning, match="shift every later value .* Greta Java and VREng"):
         write_fap(stream, tmp_path / "x.fap", dialect="xface")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
