@@ -14,7 +14,7 @@ FAP = Path(__file__).parents[1] / "data" / "fap" / "xface.fap"
 def test_export_glb_html_and_arkit_then_import(tmp_path, capsys):
     assert main(["export", str(FAP), "-o", str(tmp_path / "x.glb"),
                  "--html", str(tmp_path / "page")]) == 0
-    out = capsys.readouterr().err  # status messages go to stderr
+    out = capsys.readouterr().err  # status lines go to stderr
     assert "morph targets" in out and (tmp_path / "x.glb").stat().st_size > 100_000
     assert {p.name for p in (tmp_path / "page").iterdir()} >= {
         "index.html", "player.js", "scene.js", "face.glb"}
@@ -28,8 +28,6 @@ def test_export_glb_html_and_arkit_then_import(tmp_path, capsys):
     assert back.n_frames == 3 and np.argmax(back.values[:, 2]) == 2
 
 
-def test_export_needs_an_output_of_the_right_kind(capsys, tmp_path):
-    assert main(["export", str(FAP)]) == 2
-    assert "needs -o" in capsys.readouterr().err
-    assert main(["export", str(FAP), "-o", str(tmp_path / "x.csv")]) == 2  # no --arkit
-    assert main(["export", str(FAP), "--arkit", "-o", str(tmp_path / "x.glb")]) == 2
+def test_export_needs_an_output(capsys):
+    assert main(["export", str(FAP)]) == 2  # a usage error
+    assert "give -o" in capsys.readouterr().err
