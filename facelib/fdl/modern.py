@@ -1,10 +1,10 @@
-"""The modern FDL syntax: storyboard functions a writer calls (see ``docs/fdl.md``).
+"""The readers of the modern FDL syntax's storyboard functions (see ``docs/fdl.md``).
 
 ``say``, ``show``, ``look``, ``define_expression`` and ``define_gaze`` each take one table
-(``say`` also a plain string). The sandbox records the calls with their lines; this module
-validates them and turns them into timed cues. Times are seconds or unit strings (see
-:mod:`facelib.fdl.timing`); a cue without ``at`` starts where the previous cue of its kind
-ended.
+(``say`` also a plain string); they are declared in :mod:`facelib.fdl.functions`, which
+dispatches each call the sandbox recorded to its reader here. A reader validates the call
+into draft cues; :mod:`facelib.fdl.modern_cues` times the drafts into cues. Times are
+seconds or unit strings (see :mod:`facelib.fdl.timing`).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from facelib.checks import did_you_mean
 from facelib.errors import FdlError
@@ -22,14 +22,20 @@ from facelib.fdl.timing import parse_time
 from facelib.fdl.values import LuaTable, lua_kind
 from facelib.mpeg4.tables import fap_table
 
-__all__ = ["FUNCTIONS", "DraftCue", "DraftSpeech", "ModernParts", "read_calls"]
+if TYPE_CHECKING:
+    from facelib.fdl.functions import StoryboardFunction
 
-FUNCTIONS = ("say", "show", "look", "define_expression", "define_gaze")
-"""The storyboard functions of the modern syntax."""
+__all__ = [
+    "DraftCue",
+    "DraftSpeech",
+    "ModernParts",
+    "read_define_expression",
+    "read_define_gaze",
+    "read_look",
+    "read_say",
+    "read_show",
+]
 
-_SHOW_FIELDS = ("at", "dur", "intensity", "ease_in", "ease_out")
-_LOOK_FIELDS = ("at", "dur")
-_SAY_FIELDS = ("text", "transcript", "audio", "visemes", "at", "lang", "voice", "rate", "pitch")
 _SAY_RANGES = {"rate": (0.5, 2.5), "pitch": (0.0, 100.0)}
 _MAX_FAP_VALUE = 100_000.0
 
@@ -76,30 +82,11 @@ class ModernParts:
     gaze_defs: dict[str, Mapping[str, Any]] = field(default_factory=dict)
 
 
-def read_calls(calls: list[tuple[str, Any, int | None, int]], ctx: Context) -> ModernParts:
-    """Validate recorded calls ``(function, argument, line, n_arguments)`` into parts."""
-    parts = ModernParts()
-    readers = {
-        "say": _say,
-        "show": _show,
-        "look": _look,
-        "define_expression": _define_expression,
-        "define_gaze": _define_gaze,
-    }
-    for name, arg, line, n_args in calls:
-        if n_args != 1:
-            raise FdlError(
-                f"{name} takes one table, like {name} {{ ... }}; got {n_args} arguments",
-                path=ctx.path,
-                line=line,
-            )
-        readers[name](arg, ctx, line, parts)
-    return parts
-
-
 def _table(
-    arg: object, fn: str, ctx: Context, line: int | None, *, allowed: tuple[str, ...]
+    arg: object, fn: str, ctx: Context, line: int | None, *, allowed: tuple[str, ...] | None
 ) -> LuaTable:
+    """``arg`` as a table; FdlError if it is not one or has a field outside ``allowed``
+    (None: any field)."""
     if not isinstance(arg, LuaTable):
         raise FdlError(
             f'{fn} takes a table, like {fn} {{ "name", ... }}; got a {lua_kind(arg)} {arg!r}',
@@ -107,7 +94,7 @@ def _table(
             line=line,
         )
     for key in arg.fields:
-        if key not in allowed:
+        if allowed is not None and key not in allowed:
             raise FdlError(
                 f"{fn}: unknown field {key!r}{did_you_mean(key, allowed)}"
                 f" (fields: {', '.join(allowed)})",
@@ -147,8 +134,11 @@ def _opt_time(
     return None if key not in fields else _time(fields[key], f"{fn}: {key}", ctx, line)
 
 
-def _show(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    t = _table(arg, "show", ctx, line, allowed=_SHOW_FIELDS)
+def read_show(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``show { "name", dur = ..., at, intensity, ease_in, ease_out }``: an expression."""
+    t = _table(arg, "show", ctx, line, allowed=fn.fields)
     name = _name(t, "show", ctx, line, named="times and intensity (at = ..., dur = ...)")
     if "dur" not in t.fields:
         raise FdlError(f"show {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
@@ -187,8 +177,11 @@ def _show(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> No
     )
 
 
-def _look(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    t = _table(arg, "look", ctx, line, allowed=_LOOK_FIELDS)
+def read_look(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``look { "behaviour", args..., dur = ..., at }``: an eye behaviour."""
+    t = _table(arg, "look", ctx, line, allowed=fn.fields)
     name = _name(t, "look", ctx, line)
     if "dur" not in t.fields:
         raise FdlError(f"look {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
@@ -212,7 +205,23 @@ def _look(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> No
     )
 
 
-def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+def _check_say_values(f: Mapping[str, Any], ctx: Context, line: int | None) -> None:
+    """The types of say's named fields, and the ranges of ``rate`` and ``pitch``."""
+    for key in ("text", "transcript", "audio", "lang", "voice"):
+        if key in f and not isinstance(f[key], str):
+            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
+    for key, (low, high) in _SAY_RANGES.items():
+        value = f.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
+                                  or not low <= value <= high):
+            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
+                           path=ctx.path, line=line)
+
+
+def read_say(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``say "text"`` or ``say { "text" or transcript/audio/visemes, at }``: the speech."""
     if parts.speech is not None:
         raise FdlError(
             f"say is called a second time (the first call is on line {parts.speech.line}); "
@@ -223,7 +232,7 @@ def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> Non
     if isinstance(arg, str):
         parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
         return
-    t = _table(arg, "say", ctx, line, allowed=_SAY_FIELDS)
+    t = _table(arg, "say", ctx, line, allowed=fn.fields)
     f = t.fields
     if len(t.items) > 1 or (t.items and not isinstance(t.items[0], str)):
         raise FdlError(
@@ -240,15 +249,7 @@ def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> Non
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
-    for key in ("text", "transcript", "audio", "lang", "voice"):
-        if key in f and not isinstance(f[key], str):
-            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
-    for key, (low, high) in _SAY_RANGES.items():
-        value = f.get(key)
-        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
-                                  or not low <= value <= high):
-            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
-                           path=ctx.path, line=line)
+    _check_say_values(f, ctx, line)
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
@@ -295,10 +296,11 @@ def _visemes(
     return tuple(out)
 
 
-def _define_expression(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    if not isinstance(arg, LuaTable):
-        _table(arg, "define_expression", ctx, line, allowed=())
-    t: LuaTable = arg  # type: ignore[assignment]
+def read_define_expression(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``define_expression { "name", FAP = value..., mix = {...} }``."""
+    t = _table(arg, "define_expression", ctx, line, allowed=fn.fields)
     name = _name(t, "define_expression", ctx, line,
                  named="FAP values (raise_l_cornerlip_o = 120)")
     valid = {f.name: f for f in fap_table() if f.kind != "special"}
@@ -377,10 +379,11 @@ def _mix(value: object, name: str, ctx: Context, line: int | None) -> dict[str, 
     return out
 
 
-def _define_gaze(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    if not isinstance(arg, LuaTable):
-        _table(arg, "define_gaze", ctx, line, allowed=())
-    t: LuaTable = arg  # type: ignore[assignment]
+def read_define_gaze(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``define_gaze { "name", parameter = value... }``: an eye behaviour."""
+    t = _table(arg, "define_gaze", ctx, line, allowed=fn.fields)
     name = _name(t, "define_gaze", ctx, line, named="parameters (rate = 2.0)")
     params: dict[str, Any] = {}
     for key, value in t.fields.items():

@@ -9,7 +9,6 @@ the headless platform chosen by :mod:`facelib.rendering.platform`.
 from __future__ import annotations
 
 import os
-import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -19,6 +18,7 @@ import numpy as np
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS
+from facelib.progress import ProgressCallback, progress_callback
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import open_writer, save_png
@@ -73,27 +73,22 @@ def face_or_default(face: Deformable | None) -> Deformable:
 
 
 def iter_frames(
-    renderer: FaceRenderer, face: Deformable, stream: FapStream, *, progress: bool = False
+    renderer: FaceRenderer, face: Deformable, stream: FapStream, *,
+    progress: bool | ProgressCallback | None = False,
 ) -> Iterator[np.ndarray]:
-    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``."""
-    bar = None
-    if progress and sys.stderr.isatty():
-        try:
-            from tqdm import tqdm
-        except ImportError:
-            bar = None
-        else:
-            bar = tqdm(total=stream.n_frames, unit="frame", desc="rendering", leave=False)
-    try:
-        for start in range(0, stream.n_frames, _CHUNK):
-            vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
-            for frame_vertices in vertices:
-                yield renderer.frame(frame_vertices)
-                if bar is not None:
-                    bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
+    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``.
+
+    ``progress``: see :mod:`facelib.progress`; called with (frames done, n_frames).
+    """
+    report = progress_callback(progress, "rendering", unit="frames")
+    done = 0
+    for start in range(0, stream.n_frames, _CHUNK):
+        vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
+        for frame_vertices in vertices:
+            yield renderer.frame(frame_vertices)
+            done += 1
+            if report is not None:
+                report(done, stream.n_frames)
 
 
 def render(
@@ -106,7 +101,7 @@ def render(
     audio: str | os.PathLike[str] | None = None,
     audio_offset: float | None = None,
     background: Sequence[float] | None = None,
-    progress: bool = True,
+    progress: bool | ProgressCallback | None = True,
     fps: float | None = None,
 ) -> np.ndarray | Path:
     """Render an animation of ``face`` driven by ``source``.
@@ -124,7 +119,8 @@ def render(
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
     background: sRGB colour in [0, 1] behind the face; None uses the look's.
-    progress: show a progress bar when stderr is a terminal.
+    progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
+        None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
     fps: resample the stream to this frame rate first (None keeps the stream's).
 
     Returns
@@ -139,37 +135,53 @@ def render(
     offset = source_offset if audio_offset is None else float(audio_offset)
     face = face_or_default(face)
     if out is not None and Path(out).suffix.lower() == ".png":
-        if stream.n_frames != 1:
-            raise ParameterError(
-                f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
-                "give a folder to write one PNG per frame"
-            )
-        return save_png(render_still(face, stream.values[0], width=width, height=height,
-                                     background=background), out)
+        return _one_png(face, stream, out, width=width, height=height, background=background)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
-    with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
-        if audio is None and out is not None and Path(out).suffix.lower() == ".mp4":
-            audio = speech_audio_file(source, Path(folder) / "speech.wav")
-        with FaceRenderer(face, width=width, height=height, background=background) as renderer:
-            frames = iter_frames(renderer, face, stream, progress=progress)
-            if out is None:
-                result = np.empty((stream.n_frames, renderer.height, renderer.width, 3), np.uint8)
-                for i, image in enumerate(frames):
-                    result[i] = image
-                return result
-            writer = open_writer(
-                out, fps=stream.fps, width=width, height=height,
-                audio=audio if Path(out).suffix.lower() == ".mp4" else None,
-                audio_offset=offset, duration=stream.duration,
-            )
-            try:
-                for image in frames:
-                    writer.write(image)
-            except BaseException:
-                writer.abort()
-                raise
-            return writer.commit()
+    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+        frames = iter_frames(renderer, face, stream, progress=progress)
+        if out is None:
+            result = np.empty((stream.n_frames, renderer.height, renderer.width, 3), np.uint8)
+            for i, image in enumerate(frames):
+                result[i] = image
+            return result
+        mp4 = Path(out).suffix.lower() == ".mp4"
+        with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
+            if mp4 and audio is None:  # synthesized speech is samples: give ffmpeg a file
+                audio = speech_audio_file(source, Path(folder) / "speech.wav")
+            return _write(frames, out, stream, width=width, height=height,
+                          audio=audio if mp4 else None, audio_offset=offset)
+
+
+def _one_png(
+    face: Deformable, stream: FapStream, out: str | os.PathLike[str], *, width: int,
+    height: int, background: Sequence[float] | None,
+) -> Path:
+    """A single-frame stream rendered to the PNG ``out``."""
+    if stream.n_frames != 1:
+        raise ParameterError(
+            f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
+            "give a folder to write one PNG per frame"
+        )
+    return save_png(render_still(face, stream.values[0], width=width, height=height,
+                                 background=background), out)
+
+
+def _write(
+    frames: Iterator[np.ndarray], out: str | os.PathLike[str], stream: FapStream, *,
+    width: int, height: int, audio: Path | None, audio_offset: float,
+) -> Path:
+    """Write ``frames`` (each ``(height, width, 3) uint8``) to ``out`` at the stream's
+    frame rate; a failure removes what was written."""
+    writer = open_writer(out, fps=stream.fps, width=width, height=height, audio=audio,
+                         audio_offset=audio_offset, duration=stream.duration)
+    try:
+        for image in frames:
+            writer.write(image)
+    except BaseException:
+        writer.abort()
+        raise
+    return writer.commit()
 
 
 def render_still(

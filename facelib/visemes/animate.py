@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.checks import check_fps
+from facelib.checks import check_fps, check_number
 from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
 from facelib.errors import MissingExtraError, SpeechError, SpeechWarning
 from facelib.mpeg4.track import FapTrack
@@ -173,6 +173,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     Speech longer than ``max_frames`` raises SpeechError before the curves are computed.
     """
     fps = check_fps(fps)
+    rate = check_number("rate", rate, low=0.25, high=4.0)
     own, audio = _spoken(speech, rate=rate, language=language)
     timeline = own.shifted(speech.start_ms)
     end_ms = speech.start_ms + timeline.duration_ms
