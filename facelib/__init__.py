@@ -48,11 +48,14 @@ _LAZY = {
     "import_arkit": "facelib.export",
     "to_arkit": "facelib.export",
     "from_arkit": "facelib.export",
+    "setup_face": "facelib.engine.setup",
+    "write_face": "facelib.engine.writer",
 }
 
 
 def __getattr__(name: str) -> Any:
-    """Rendering, the viewer, plotting and the exports load on first use."""
+    """Rendering, the viewer, plotting, the exports and face set-up import OpenGL,
+    matplotlib, pygltflib or trimesh: load them on first use."""
     if name in _LAZY:
         import importlib
 
@@ -98,9 +101,11 @@ __all__ = [
     "render_still",
     "run_fdl",
     "save_png",
+    "setup_face",
     "sync",
     "to_arkit",
     "view",
     "visemes",
+    "write_face",
     "write_fap",
 ]

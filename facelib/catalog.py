@@ -2,8 +2,7 @@
 
 Expressions come from the library (descriptions in ``facelib/data/catalog/expressions.csv``),
 eye behaviours from ``facelib/data/gaze/behaviours.json``, visemes from the MPEG-4 table
-``facelib/data/mpeg4_visemes.csv`` (every alias a script may use is listed with its viseme),
-voices from espeak-ng and the tested languages from ``facelib/data/speech/languages.csv``.
+``facelib/data/mpeg4_visemes.csv`` (every alias a script may use is listed with its viseme).
 """
 
 from __future__ import annotations
@@ -30,16 +29,23 @@ class Entry:
     name: str
     description: str
     image: str = ""
+    languages: tuple[str, ...] = ()
 
 
-def catalog(kind: str) -> tuple[Entry, ...]:
-    """The entries of ``kind``, one of :data:`KINDS`, in library order."""
+def catalog(kind: str, *, lang: str | None = None) -> tuple[Entry, ...]:
+    """The entries of ``kind``, one of :data:`KINDS`, in library order; ``lang`` keeps only
+    the voices that speak a language whose code starts with it."""
     if kind not in KINDS:
         raise FacelibError(f"unknown kind {kind!r}; choose one of {', '.join(KINDS)}")
     listers: dict[str, Callable[[], tuple[Entry, ...]]] = {
         "expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
         "voices": _voices, "languages": _languages}
-    return listers[kind]()
+    entries = listers[kind]()
+    if lang and kind == "voices":
+        wanted = lang.lower()
+        entries = tuple(e for e in entries if any(
+            code.startswith(wanted) for code in e.languages))
+    return entries
 
 
 @cache
@@ -78,17 +84,16 @@ def _behaviours() -> tuple[Entry, ...]:
 
 
 def _voices() -> tuple[Entry, ...]:
-    """espeak-ng's voices (the ``speech`` extra): identifier, name, languages, gender."""
-    from facelib.speech import list_voices
+    from facelib.speech.espeak import list_voices
 
-    return tuple(Entry(v.identifier, f"{v.name}; languages {', '.join(v.languages)}"
-                       + (f"; {v.gender}" if v.gender else ""))
-                 for v in list_voices())
+    return tuple(
+        Entry(v.identifier, f"{v.name} ({', '.join(v.languages)}"
+                            + (f", {v.gender})" if v.gender else ")"), languages=v.languages)
+        for v in list_voices())
 
 
 def _languages() -> tuple[Entry, ...]:
-    """The tested languages (``facelib/data/speech/languages.csv``) and the voice of each."""
     from facelib.speech.synth import languages
 
-    return tuple(Entry(lang.lang, f"{lang.name} (espeak-ng voice {lang.voice})")
-                 for lang in languages().values())
+    return tuple(Entry(lang.lang, f"{lang.name} (espeak-ng voice {lang.voice}); e.g. "
+                                  f"{lang.sentence!r}") for lang in languages().values())

@@ -124,6 +124,7 @@ class Storyboard:
         against its library and adds ``expression_defs[name]`` (FAP overrides) on top.
         Mixes of expressions the storyboard itself defines are resolved at load time.
     output: where the storyboard asks the ``.fap`` to go, or None.
+    face: the face definition JSON the storyboard is played on, or None (the default head).
     language: the storyboard's language (``language = "pt"``), used by speech that names
         none; None means English.
     """
@@ -138,6 +139,7 @@ class Storyboard:
     gaze_defs: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     output: Path | None = None
     expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    face: Path | None = None
     language: str | None = None
 
     def __post_init__(self) -> None:

@@ -168,6 +168,8 @@ class Face:
         radians (eq. 4.1-4.5).
     regions: the influence regions.
     pivots: ``eye_l``, ``eye_r``, ``head``, ``jaw`` -> (3,) float64 positions.
+    neck: ``(point (3,), unit normal (3,) into the head, blend distance)`` of the plane
+        where head rotations fade out.
     operator: scipy CSR array (84, 3V) float32: vertex displacements (flattened ``(V, 3)``)
         per FAP unit, for every translational FAP that deforms linearly.
     """
@@ -180,6 +182,7 @@ class Face:
     fapu: Mapping[str, float]
     regions: tuple[Region, ...]
     pivots: Mapping[str, np.ndarray]
+    neck: tuple[np.ndarray, np.ndarray, float]
     operator: sp.csr_array = field(repr=False)
     _columns: np.ndarray = field(repr=False)
     _dense: np.ndarray = field(repr=False)
@@ -231,6 +234,8 @@ class Face:
             fapu=fapu,
             regions=tuple(regions),
             pivots=MappingProxyType(pivot_map),
+            neck=(_readonly(neck[0], np.float64), _readonly(neck[1], np.float64),
+                  float(neck[2])),
             operator=operator,
             _columns=columns,
             _dense=dense,

@@ -3,8 +3,9 @@
 One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts, or the
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
-``fps`` (default 25), ``seed`` (default 0), ``output`` and ``language`` (default English; the
-language of speech that names none) set the storyboard options; every name is declared in
+``fps`` (default 25), ``seed`` (default 0), ``output``, ``face`` (a face definition JSON,
+e.g. one made by ``facelib face setup``) and ``language`` (default English; the language of
+speech that names none) set the storyboard options; every name is declared in
 :mod:`facelib.fdl.functions`. Each syntax converts to cues in its own module
 (:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs the
 script, reads the settings and merges the two.
@@ -194,12 +195,19 @@ def _build(
     gaze = thesis_cues.gaze_cues(lists.get("eyes"))
     speech = _speech(fdl, fdl_line, lists.get("Sentence"), parts, ctx)
     output = _output(chunk, fdl, fdl_line, ctx)
+    language = _global(chunk, "language")
+    if language is not None and not (isinstance(language, str) and language.strip()):
+        raise FdlError(f"language must be a language code like \"pt\"; got {language!r}",
+                       path=name, line=_line(text, "language"))
     if output is not None:
         _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
+    face_value = _global(chunk, "face")
+    face = (None if face_value is None else resolve_inside(
+        base_dir, face_value, what="face", path=name, line=_line(text, "face")))
     return Storyboard(
         path=file,
-        language=_language(chunk, ctx),
         fps=fps,
+        language=language.strip() if isinstance(language, str) else None,
         seed=seed,
         speech=speech,
         expressions=_by_start((*expressions, *modern_cues.expression_cues(
@@ -209,6 +217,7 @@ def _build(
         gaze_defs=parts.gaze_defs,
         output=output,
         expression_mixes=parts.expression_mixes,
+        face=face,
     )
 
 
@@ -329,15 +338,6 @@ def _speech(
             line=said.line,
         )
     return modern_cues.speech_spec(said, ctx)
-
-
-def _language(chunk: ChunkResult, ctx: Context) -> str | None:
-    """The global ``language`` (a language code such as ``"pt"``), or None."""
-    value = _global(chunk, "language")
-    if value is not None and not (isinstance(value, str) and value.strip()):
-        raise FdlError(f'language must be a language code like "pt"; got {value!r}',
-                       path=ctx.path, line=_line(ctx.source, "language"))
-    return value.strip() if isinstance(value, str) else None
 
 
 def _output(

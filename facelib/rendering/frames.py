@@ -63,13 +63,18 @@ def speech_audio_file(source: object, path: Path) -> Path | None:
     return path
 
 
-def face_or_default(face: Deformable | None) -> Deformable:
-    """``face``, or facelib's default head when it is None."""
-    if face is not None:
-        return face
-    from facelib.engine import default_face
+def face_or_default(face: Deformable | str | os.PathLike[str] | None,
+                    source: object = None) -> Deformable:
+    """``face``; a face definition JSON path loaded; None: the face the source's storyboard
+    names (``face = "..."``), else facelib's default head."""
+    from facelib.engine import default_face, load_face
 
-    return default_face()
+    if face is None:
+        storyboard = getattr(source, "storyboard", None)
+        face = getattr(storyboard, "face", None)
+    if isinstance(face, (str, os.PathLike)):
+        return load_face(Path(face))
+    return default_face() if face is None else face
 
 
 def iter_frames(
@@ -94,7 +99,7 @@ def iter_frames(
 def render(
     source: FapStream | HasFaps,
     *,
-    face: Deformable | None = None,
+    face: Deformable | str | os.PathLike[str] | None = None,
     out: str | os.PathLike[str] | None = None,
     width: int = 640,
     height: int = 480,
@@ -111,7 +116,8 @@ def render(
     source: a :class:`FapStream`, or an animation with ``.faps`` (and optional ``.audio``,
         ``.audio_offset``).
     face: the face to deform (``Face``-like: ``vertices``, ``triangles``, ``vertex_colors``,
-        ``parts``, ``deform``); None loads the default head.
+        ``parts``, ``deform``) or a face definition JSON path; None takes the face the
+        storyboard names (``face = "..."``), else the default head.
     out: None returns the frames; a path writes them by suffix: ``.mp4`` (H.264, with the
         audio), ``.gif``, or a folder (no suffix) of ``frame_NNNNNN.png``; ``.png`` writes a
         single-frame source as one still.
@@ -133,24 +139,22 @@ def render(
         stream = stream.resample(fps)
     audio = source_audio if audio is None else Path(audio)
     offset = source_offset if audio_offset is None else float(audio_offset)
-    face = face_or_default(face)
+    face = face_or_default(face, source)
     if out is not None and Path(out).suffix.lower() == ".png":
         return _one_png(face, stream, out, width=width, height=height, background=background)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
-    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
-        frames = iter_frames(renderer, face, stream, progress=progress)
-        if out is None:
-            result = np.empty((stream.n_frames, renderer.height, renderer.width, 3), np.uint8)
-            for i, image in enumerate(frames):
-                result[i] = image
-            return result
-        mp4 = Path(out).suffix.lower() == ".mp4"
-        with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
-            if mp4 and audio is None:  # synthesized speech is samples: give ffmpeg a file
-                audio = speech_audio_file(source, Path(folder) / "speech.wav")
-            return _write(frames, out, stream, width=width, height=height,
-                          audio=audio if mp4 else None, audio_offset=offset)
+    with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
+        if audio is None and out is not None and Path(out).suffix.lower() == ".mp4":
+            audio = speech_audio_file(source, Path(folder) / "speech.wav")
+        with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+            frames = iter_frames(renderer, face, stream, progress=progress)
+            if out is None:
+                return np.stack(list(frames)) if stream.n_frames else np.empty(
+                    (0, renderer.height, renderer.width, 3), np.uint8)
+            mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
+            return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
+                          audio_offset=offset)
 
 
 def _one_png(

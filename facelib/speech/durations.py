@@ -45,8 +45,8 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
         following = tokens[k + 1] if k + 1 < len(tokens) else None
         pause = pauses.get(following, 0) if following else pauses["edge"]
         start = t
-        for phone, ms in _word_durations(token, final=bool(pause), rate=rate, rules=rules,
-                                         guessed=guessed):
+        for phone, ms in _word_durations(_phones_of(token, guessed), token, final=bool(pause),
+                                         rate=rate, rules=rules):
             phones.append(Span(phone, t, t + ms))
             t += ms
         words.append(Span(token, start, t))
@@ -56,23 +56,22 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
             words.append(Span(SILENCE, t, t + ms))
             t += ms
     if guessed:
-        names = ", ".join(repr(w) for w in dict.fromkeys(guessed))
-        warnings.warn(f"not in the pronunciation dictionary, pronounced as spelt: {names}",
-                      PronunciationWarning, stacklevel=2)
+        warnings.warn(f"not in the pronunciation dictionary, pronounced as spelt: "
+                      f"{', '.join(repr(w) for w in dict.fromkeys(guessed))}", PronunciationWarning,
+                      stacklevel=2)
     phones = _join_silences(phones)
     words = _join_silences(words)
     return PhoneTimeline(tuple(phones), tuple(words), "durations", t)
 
 
 def _word_durations(
-    word: str, *, final: bool, rate: float, rules: DurationRules, guessed: list[str]
+    word_phones: tuple[str, ...], word: str, *, final: bool, rate: float, rules: DurationRules
 ) -> list[tuple[str, int]]:
-    """(phone, ms) of ``word``: each phone's mean duration, shortened if it is the vowel of
-    a short one-vowel word, lengthened if it ends a phrase (``final``), never below the
-    phone's minimum, scaled by ``rate`` and floored at ``rules.floor_ms``. A word spelt out
-    by the letter-to-sound rules is added to ``guessed``."""
+    """(phone, ms) of ``word`` spoken as ``word_phones``: each phone's mean duration,
+    shortened if it is the vowel of a short one-vowel word, lengthened if it ends a phrase
+    (``final``), never below the phone's minimum, scaled by ``rate`` and floored at
+    ``rules.floor_ms``."""
     table = phone_durations()
-    word_phones = _phones_of(word, guessed)
     n_vowels = sum(p in rules.vowels for p in word_phones)
     out = []
     for i, phone in enumerate(word_phones):
