@@ -205,6 +205,19 @@ def read_look(
     )
 
 
+def _check_say_values(f: Mapping[str, Any], ctx: Context, line: int | None) -> None:
+    """The types of say's named fields, and the ranges of ``rate`` and ``pitch``."""
+    for key in ("text", "transcript", "audio", "lang", "voice"):
+        if key in f and not isinstance(f[key], str):
+            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
+    for key, (low, high) in _SAY_RANGES.items():
+        value = f.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
+                                  or not low <= value <= high):
+            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
+                           path=ctx.path, line=line)
+
+
 def read_say(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
@@ -236,15 +249,7 @@ def read_say(
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
-    for key in ("text", "transcript", "audio", "lang", "voice"):
-        if key in f and not isinstance(f[key], str):
-            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
-    for key, (low, high) in _SAY_RANGES.items():
-        value = f.get(key)
-        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
-                                  or not low <= value <= high):
-            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
-                           path=ctx.path, line=line)
+    _check_say_values(f, ctx, line)
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
