@@ -183,7 +183,7 @@ def _gaze(local: np.ndarray, layout: LandmarkLayout, span: slice,
 
 
 def _fit(local: np.ndarray, span: slice, units: Mapping[str, float], model: RigModel,
-         values: np.ndarray, mask: np.ndarray) -> None:
+         *, values: np.ndarray, mask: np.ndarray) -> None:
     """FAPs of ``model`` by fitting the face's rig, plus a small residual head motion, to
     the landmark motion relative to nearby anchors (:mod:`~facelib.tracking.rigfit`)."""
     points = local[:, model.landmarks]
@@ -279,7 +279,7 @@ def measure_faps(
         values[:, col] = sign * disp[:, row, axis] / units[unit]
         mask[:, col] = True
     if model is not None:
-        _fit(local_all, span, units, model, values, mask)
+        _fit(local_all, span, units, model, values=values, mask=mask)
     _gaze(local, layout, span, values, mask)
     if pose is not None:
         for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
