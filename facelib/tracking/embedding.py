@@ -19,9 +19,8 @@ from facelib.data import json_data
 from facelib.data import path as data_path
 from facelib.errors import DataError, TrackingError
 from facelib.mpeg4 import N_FAPS, FapStream
-from facelib.rendering import FaceRenderer
 from facelib.rendering.protocols import Deformable
-from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+from facelib.tracking.mediapipe import N_LANDMARKS
 
 __all__ = ["default_head_embedding", "embed_landmarks"]
 
@@ -40,6 +39,9 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
     radius: pixels; among the vertices projecting this close to a landmark, the one
         nearest the camera is taken (else the nearest projection).
     """
+    from facelib.rendering import FaceRenderer
+    from facelib.tracking.mediapipe import FaceMeshTracker
+
     radius = check_number("radius", radius, low=0, low_open=True)
     values = np.zeros(N_FAPS, np.float32)
     values[2] = check_number("open_jaw", open_jaw, low=0)
