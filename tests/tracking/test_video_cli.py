@@ -40,7 +40,8 @@ def test_track_writes_fap_landmarks_and_mirror(face_video, tmp_path, capsys):
     jaw = stream.values[:, 2]
     # the jaw opens late, not early (the rig fit shares the opening with the lower-lip FAPs,
     # so open_jaw comes back at about a quarter of its size, see docs/performance-driven.md)
-    assert jaw[-1] > 50 and jaw[-1] > 4 * np.abs(jaw[:4]).max()
+    assert jaw[-1] > 50 and jaw[-1] > 2.5 * np.abs(jaw[:4]).max()
+    assert np.corrcoef(jaw, np.clip(np.arange(N) - 4, 0, None))[0, 1] > 0.8
     marks = read_landmarks(tmp_path / "l.csv")
     assert marks.landmarks.shape == (N, 478, 3) and marks.fps == 25
     info = probe_video(tmp_path / "mirror.mp4")
