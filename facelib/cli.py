@@ -116,6 +116,19 @@ def _align(args: argparse.Namespace) -> int:
     return 0
 
 
+def _evaluate(args: argparse.Namespace) -> int:
+    from facelib.evaluate import DEFORMERS, evaluate_deformers, evaluation_poses, write_evaluation
+
+    names = tuple(n.strip() for n in args.deformers.split(",")) if args.deformers else DEFORMERS
+    kinds = tuple(k.strip() for k in args.poses.split(","))
+    ev = evaluate_deformers(names, group=args.region, poses=evaluation_poses(kinds),
+                            face_path=args.face)
+    for path in write_evaluation(ev, args.output, sheet=not args.no_sheet, stem=args.stem,
+                                 face_path=args.face):
+        print(f"wrote {path}")
+    return 0
+
+
 def _span(text: str) -> tuple[int, int]:
     """``"N"`` -> (N, N + 1); ``"A:B"`` -> (A, B)."""
     try:
@@ -266,6 +279,18 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("-o", "--output", required=True, help="OUT.json, OUT.tsv or OUT.sb")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.set_defaults(run=_align)
+
+    evaluate = commands.add_parser(
+        "evaluate", help="compare deformers by lip roughness (CSV, Markdown, contact sheet)")
+    evaluate.add_argument("-o", "--output", required=True, help="folder for the results")
+    evaluate.add_argument("--deformers", help="comma-separated names (default: all seven)")
+    evaluate.add_argument("--region", default="lips", help="region or group to switch")
+    evaluate.add_argument("--poses", default="viseme,expression,syllable",
+                          help="comma-separated pose kinds: viseme, expression, syllable")
+    evaluate.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    evaluate.add_argument("--stem", default="deformers", help="file name stem")
+    evaluate.add_argument("--no-sheet", action="store_true", help="skip the mouth contact sheet")
+    evaluate.set_defaults(run=_evaluate)
     _add_track_command(commands)
     return parser
 

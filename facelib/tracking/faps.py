@@ -76,7 +76,7 @@ class TrackedFaps:
 
 @cache
 def _model() -> dict[str, dict[str, float]]:
-    return json_data("tracking/model.json")  # type: ignore[no-any-return]
+    return json_data("tracking/model.json")
 
 
 def face_frame(landmarks: np.ndarray) -> np.ndarray:
