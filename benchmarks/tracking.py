@@ -26,23 +26,12 @@ from facelib.tracking.closedloop import (
     event_recall,
     lip_closures,
     lip_gap,
+    with_head_turns,
 )
 from facelib.tracking.faps import measure_faps
 from facelib.tracking.mediapipe import FaceMeshTracker
 
 FAPS = (3, 53, 54, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
-
-
-def with_head_turns(stream: FapStream, *, frames: int | None = None) -> FapStream:
-    """``stream`` (cut to ``frames``) with head pitch/yaw/roll replaced by slow sweeps."""
-    values = np.array(stream.values[:frames])
-    mask = np.array(stream.mask[:frames])
-    t = np.arange(len(values)) / stream.fps
-    ramp = np.clip(t, 0, 1)
-    for fap_id, degrees, period in ((48, 10, 3.1), (49, 20, 4.0), (50, 8, 5.3)):
-        values[:, fap_id - 1] = ramp * np.radians(degrees) * np.sin(2 * np.pi * t / period) / 1e-5
-        mask[:, fap_id - 1] = True
-    return FapStream(stream.fps, values, mask)
 
 
 def report(title: str, truth: FapStream) -> None:

@@ -16,13 +16,13 @@ import numpy as np
 
 from facelib.checks import check_count
 from facelib.engine import Face, default_face
-from facelib.mpeg4 import N_FAPS, FapStream
+from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 
 __all__ = ["ClosedLoop", "closed_loop", "closure_events", "event_recall", "lip_closures",
-           "lip_gap", "with_neutral_lead"]
+           "lip_gap", "with_head_turns", "with_neutral_lead"]
 
 BLINK_FAPS = (19, 20)
 """Upper-lid FAPs whose peaks are blinks."""
@@ -60,6 +60,20 @@ class ClosedLoop:
         b = self.tracked.stream.values[:, fap_id - 1].astype(np.float64)
         a = a - a.mean()
         return float((a @ (b - b.mean())) / (a @ a)) if a @ a > 0 else float("nan")
+
+
+def with_head_turns(stream: FapStream, *, frames: int | None = None) -> FapStream:
+    """``stream`` (cut to ``frames``) with head pitch/yaw/roll replaced by slow sweeps that
+    grow over the first second to 10, 20 and 8 degrees (periods 3.1, 4.0, 5.3 s)."""
+    values = np.array(stream.values[:frames])
+    mask = np.array(stream.mask[:frames])
+    t = np.arange(len(values)) / stream.fps
+    ramp = np.clip(t, 0, 1)
+    for fap_id, degrees, period in ((48, 10, 3.1), (49, 20, 4.0), (50, 8, 5.3)):
+        sweep = np.radians(degrees) * np.sin(2 * np.pi * t / period)
+        values[:, fap_id - 1] = ramp * sweep / ANGLE_UNIT
+        mask[:, fap_id - 1] = True
+    return FapStream(stream.fps, values, mask)
 
 
 def with_neutral_lead(stream: FapStream, frames: int) -> FapStream:
