@@ -200,8 +200,12 @@ def default_rig() -> RigModel:
     from facelib.engine import default_face
     from facelib.tracking.embedding import default_head_embedding
 
-    anchors = landmark_layout("mediapipe").anchors
-    return rig_model(default_face(), default_head_embedding(), np.arange(468), anchors=anchors)
+    layout = landmark_layout("mediapipe")
+    face = default_face()
+    on_face = layout.feature_point_positions(face.vertices[default_head_embedding()][None])[0]
+    measured = user_fapu(dict(zip(layout.feature_points, on_face, strict=True)))
+    return rig_model(face, default_head_embedding(), np.arange(468), anchors=layout.anchors,
+                     landmark_fapu=measured)
 
 
 def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:

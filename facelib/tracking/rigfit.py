@@ -5,8 +5,12 @@ one FAP moves many points and one point is moved by many FAPs: opening the jaw l
 lip corners, a smile lifts the cheeks. Here the avatar's deformation is linearised at the
 neutral face, ``J[k]`` = how every embedded landmark moves (face frame x, y) per unit of
 FAP k in units of that FAP's FAPU, and each frame's landmark displacements ``d`` (neutral
-head frame, pixels) are explained as ``d ≈ Σ_k f_k U_k J[k]`` with ``U_k`` the user's
-FAPU of FAP k: a ridge-regularised least-squares solve for all frames at once.
+head frame, pixels) are explained as ``d ≈ Σ_k f_k U_k r_k J[k]``: ``U_k`` is the user's
+FAPU of FAP k measured on the tracker's landmarks, ``r_k`` the face's own FAPU over the
+same measurement on the face (the tracker's landmarks may place 9.15 or the lips a little
+differently from the face definition: measured alike on both sides, the user's proportions
+carry over and the FAPs come out in the face's units). A ridge-regularised least-squares
+solve for all frames at once.
 
 Only translational x/y FAPs that move some landmark take part (jaw, lips, lids, brows,
 cheeks, nose); gaze and head pose are measured directly (:mod:`facelib.tracking.faps`).
@@ -45,6 +49,8 @@ class RigModel:
         in units of that FAP's FAPU (dimensionless).
     anchors: ``(L,) int64`` for each landmark, the position in ``landmarks`` of the anchor
         its motion is measured against (itself for anchors).
+    fapu_ratio: FAPU name -> the face's FAPU over its FAPU measured on the tracker's
+        landmarks (1.0 where they agree).
     """
 
     faps: np.ndarray
@@ -52,10 +58,13 @@ class RigModel:
     landmarks: np.ndarray
     jacobian: np.ndarray
     anchors: np.ndarray
+    fapu_ratio: Mapping[str, float]
 
 
 def rig_model(face: Face, vertex_of_landmark: np.ndarray, landmarks: np.ndarray,
-              *, anchors: np.ndarray | None = None, min_motion: float = 0.02) -> RigModel:
+              *, anchors: np.ndarray | None = None,
+              landmark_fapu: Mapping[str, float] | None = None,
+              min_motion: float = 0.02) -> RigModel:
     """Linearise ``face`` at neutral for the given landmarks.
 
     Parameters
@@ -68,6 +77,8 @@ def rig_model(face: Face, vertex_of_landmark: np.ndarray, landmarks: np.ndarray,
         taken relative to the nearest one (on the neutral face), so that what is left of
         the head motion after the pose fit, which grows with the distance to the point
         the pose was fitted on, mostly cancels. None: motion relative to the head frame.
+    landmark_fapu: the face's FAPU measured on the tracker's landmarks (as the user's
+        are); None takes the face's own.
     min_motion: drop FAPs that move no landmark by more than this many FAPU per FAP unit.
     """
     anchors = np.zeros(0, np.int64) if anchors is None else np.asarray(anchors, np.int64)
@@ -91,8 +102,10 @@ def rig_model(face: Face, vertex_of_landmark: np.ndarray, landmarks: np.ndarray,
         columns.append(motion)
     jac = np.stack(columns)
     jac.flags.writeable = False
+    measured = face.fapu if landmark_fapu is None else landmark_fapu
+    ratio = {name: float(face.fapu[name] / measured[name]) for name in face.fapu}
     return RigModel(np.array(ids, np.int64), tuple(units), np.asarray(landmarks, np.int64), jac,
-                    _nearest_anchor(rest, np.asarray(landmarks, np.int64), anchors))
+                    _nearest_anchor(rest, np.asarray(landmarks, np.int64), anchors), ratio)
 
 
 def _nearest_anchor(rest: np.ndarray, landmarks: np.ndarray, anchors: np.ndarray) -> np.ndarray:
@@ -132,7 +145,7 @@ def fit_faps(model: RigModel, displacements: np.ndarray, fapu: Mapping[str, floa
     outer lip FAPs) and keeps unobservable combinations at 0.
     """
     ridge = check_number("ridge", ridge, low=0)
-    scale = np.array([fapu[u] for u in model.units])
+    scale = np.array([fapu[u] * model.fapu_ratio[u] for u in model.units])
     jac = model.jacobian * scale[:, None, None]  # (m, L, 2)
     m = len(jac)
     if rest is not None:
