@@ -38,6 +38,8 @@ _LAZY = {
     "save_png": "facelib.rendering.frames",
     "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
+    "landmarks_to_faps": "facelib.tracking.faps",
+    "track_video_faps": "facelib.tracking.video",
 }
 
 
@@ -71,6 +73,7 @@ __all__ = [
     "fdl",
     "feature_point",
     "gaze",
+    "landmarks_to_faps",
     "load_face",
     "mpeg4",
     "plot_curves",
@@ -80,6 +83,7 @@ __all__ = [
     "run_fdl",
     "save_png",
     "sync",
+    "track_video_faps",
     "view",
     "visemes",
     "write_fap",
