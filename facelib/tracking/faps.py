@@ -223,6 +223,36 @@ def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     return out
 
 
+def _inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
+            rig: RigModel | Literal["auto", "default"] | None
+            ) -> tuple[np.ndarray, LandmarkLayout, RigModel | None]:
+    """Checked ``(n, K, D)`` landmarks, the layout, and the rig model to fit (or None)."""
+    data = np.asarray(landmarks, np.float64)
+    if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
+        raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
+    if isinstance(layout, str):
+        layout = landmark_layout(layout, data.shape[1])
+    if rig == "auto":
+        rig = "default" if layout.name == "mediapipe" and data.shape[2] == 3 else None
+    if rig == "default" and layout.name != "mediapipe":
+        raise ParameterError(f"rig='default' needs MediaPipe landmarks, not {layout.name!r}")
+    return data, layout, default_rig() if rig == "default" else rig
+
+
+def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
+            states: Mapping[str, np.ndarray] | None,
+            relations: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Smoothing, the floor of unidirectional FAPs, then eq. 4.17."""
+    if smooth:
+        values = _smooth(values, mask, rate)
+    for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
+        if fap.bidirectional is False and fap.min == 0:
+            values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
+    if relations or states:
+        values, mask = apply_relations(values, mask, frame_states=states)
+    return values, mask
+
+
 def measure_faps(
     landmarks: np.ndarray,
     *,
@@ -256,31 +286,21 @@ def measure_faps(
         always uses eq. 4.16.
     """
     rate = check_fps(fps)
-    data = np.asarray(landmarks, np.float64)
-    if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
-        raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
-    if isinstance(layout, str):
-        layout = landmark_layout(layout, data.shape[1])
-    if rig == "auto":
-        rig = "default" if layout.name == "mediapipe" and data.shape[2] == 3 else None
-    if rig == "default" and layout.name != "mediapipe":
-        raise ParameterError(f"rig='default' needs MediaPipe landmarks, not {layout.name!r}")
+    data, layout, model = _inputs(landmarks, layout, rig)
     data, filled = fill_gaps(data)
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
     points = face_frame(data)
     span = _neutral_span(neutral, len(data))
-    model = default_rig() if rig == "default" else rig
     local_all, pose = _remove_pose(points, layout, span, points[span].mean(axis=0))
     local = layout.feature_point_positions(local_all)
     rest = local[span].mean(axis=0)
     units = user_fapu(dict(zip(layout.feature_points, rest, strict=True)), fapu)
     values = np.zeros((len(data), N_FAPS))
     mask = np.zeros((len(data), N_FAPS), bool)
-    disp = local - rest
-    for col, row, axis, sign, unit in _plan(layout, pose):
-        values[:, col] = sign * disp[:, row, axis] / units[unit]
+    for col, row, axis, sign, unit in _plan(layout, pose):  # eq. 4.16, per axis
+        values[:, col] = sign * (local - rest)[:, row, axis] / units[unit]
         mask[:, col] = True
     if model is not None:
         _fit(local_all, span, units, model, values=values, mask=mask)
@@ -289,13 +309,8 @@ def measure_faps(
         for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
             values[:, fap_id - 1] = angle / ANGLE_UNIT
             mask[:, fap_id - 1] = True
-    if smooth:
-        values = _smooth(values, mask, rate)
-    for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
-        if fap.bidirectional is False and fap.min == 0:
-            values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
-    if relations or states:
-        values, mask = apply_relations(values, mask, frame_states=states)
+    values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
+                           relations=relations)
     return TrackedFaps(FapStream(rate, values, mask), units, pose, filled)
 
 
