@@ -48,7 +48,8 @@ class RigModel:
     jacobian: ``(m, L, 2) float64`` face-frame x/y motion of each landmark per FAP unit,
         in units of that FAP's FAPU (dimensionless).
     anchors: ``(L,) int64`` for each landmark, the position in ``landmarks`` of the anchor
-        its motion is measured against (itself for anchors).
+        its motion is measured against (itself for anchors, -1 for landmarks far from every
+        anchor, whose motion stays in the head frame); empty when there are no anchors.
     fapu_ratio: FAPU name -> the face's FAPU over its FAPU measured on the tracker's
         landmarks (1.0 where they agree).
     """
@@ -73,10 +74,10 @@ def rig_model(face: Face, vertex_of_landmark: np.ndarray, landmarks: np.ndarray,
     vertex_of_landmark: ``(K,) int`` the face vertex of each tracker landmark
         (:mod:`facelib.tracking.embedding`).
     landmarks: ``(L,) int`` the landmarks to use (skin points that FAPs move).
-    anchors: landmark indices that serve as local references: each landmark's motion is
-        taken relative to the nearest one (on the neutral face), so that what is left of
-        the head motion after the pose fit, which grows with the distance to the point
-        the pose was fitted on, mostly cancels. None: motion relative to the head frame.
+    anchors: landmark indices that serve as local references: a landmark near one (within
+        0.4 of the anchors' spread on the neutral face) has its motion taken relative to
+        the nearest, so that what is left of the head motion after the pose fit mostly
+        cancels; the others, and all with None, move in the head frame.
     landmark_fapu: the face's FAPU measured on the tracker's landmarks (as the user's
         are); None takes the face's own.
     min_motion: drop FAPs that move no landmark by more than this many FAPU per FAP unit.
@@ -108,14 +109,17 @@ def rig_model(face: Face, vertex_of_landmark: np.ndarray, landmarks: np.ndarray,
                     _nearest_anchor(rest, np.asarray(landmarks, np.int64), anchors), ratio)
 
 
-def _nearest_anchor(rest: np.ndarray, landmarks: np.ndarray, anchors: np.ndarray) -> np.ndarray:
+def _nearest_anchor(rest: np.ndarray, landmarks: np.ndarray, anchors: np.ndarray,
+                    reach: float = 0.4) -> np.ndarray:
     """For each of ``landmarks`` (neutral x/y ``rest``), the position in ``landmarks`` of
-    the nearest of ``anchors``."""
+    the nearest of ``anchors`` if it lies within ``reach`` times the anchors' spread, else
+    -1 (the landmark's motion stays in the head frame). Empty if there are no anchors."""
     where = np.flatnonzero(np.isin(landmarks, anchors))
     if not where.size:
-        return np.arange(len(landmarks))
+        return np.zeros(0, np.int64)
+    spread = float(np.max(np.linalg.norm(rest[where, None] - rest[None, where], axis=2)))
     dist = np.linalg.norm(rest[:, None, :] - rest[None, where, :], axis=2)
-    out = where[np.argmin(dist, axis=1)]
+    out = np.where(dist.min(axis=1) <= reach * spread, where[np.argmin(dist, axis=1)], -1)
     out.flags.writeable = False
     return out
 
@@ -128,6 +132,11 @@ def rigid_columns(rest: np.ndarray) -> np.ndarray:
     zero, one = np.zeros_like(x), np.ones_like(x)
     return np.stack([np.stack(c, axis=-1) for c in (
         (zero, -z), (z, zero), (-y, x), (x, y), (one, zero), (zero, one))])
+
+
+def _at_anchor(motion: np.ndarray, anchors: np.ndarray) -> np.ndarray:
+    """``(..., L, 2)`` motion of each landmark's anchor (0 where it has none)."""
+    return np.where((anchors >= 0)[:, None], motion[..., np.maximum(anchors, 0), :], 0.0)
 
 
 def fit_faps(model: RigModel, displacements: np.ndarray, fapu: Mapping[str, float], *,
@@ -150,12 +159,17 @@ def fit_faps(model: RigModel, displacements: np.ndarray, fapu: Mapping[str, floa
     m = len(jac)
     if rest is not None:
         jac = np.concatenate([jac, rigid_columns(rest)])
-    jac = (jac - jac[:, model.anchors]).reshape(len(jac), -1)
+    anchored = model.anchors.size > 0
+    if anchored:
+        jac = jac - _at_anchor(jac, model.anchors)
+    jac = jac.reshape(len(jac), -1)
     penalty = ridge * float(np.einsum("ij,ij->", jac[:m], jac[:m])) / m
     gram = jac @ jac.T
     gram[np.arange(m), np.arange(m)] += penalty
     # rigid columns that anchoring cancels (the shifts) get a tiny weight, not a singularity
     gram[np.arange(m, len(gram)), np.arange(m, len(gram))] += 1e-9 * penalty + 1e-12
     moved = np.asarray(displacements, np.float64)
-    rhs = (moved - moved[:, model.anchors]).reshape(len(moved), -1) @ jac.T
+    if anchored:
+        moved = moved - _at_anchor(moved, model.anchors)
+    rhs = moved.reshape(len(moved), -1) @ jac.T
     return np.linalg.solve(gram, rhs.T).T[:, :m]
