@@ -79,3 +79,28 @@ def test_track_landmark_file_needs_rate_and_layout(tmp_path, capsys):
     path = write_landmarks_csv(tmp_path / "five.csv", data, fps=25)
     assert main(["track", str(path), "-o", str(tmp_path / "c.fap")]) == 1
     assert "--layout" in capsys.readouterr().err
+
+
+def test_lost_stretch_and_a_second_face_are_named(face_video, tmp_path, capsys):
+    from PIL import Image
+
+    from facelib.rendering.video import open_writer
+    from facelib.tracking.video import read_video
+
+    _, frames = read_video(face_video)
+    writer = open_writer(tmp_path / "edited.mp4", fps=25, width=640, height=480)
+    for i, image in enumerate(frames):
+        frame = np.array(image)
+        if 5 <= i <= 7:
+            frame[:] = 40                                   # the face is gone
+        elif 10 <= i <= 12:                                 # a smaller second face
+            small = np.asarray(Image.fromarray(image[60:420, 160:480]).resize((200, 225)))
+            frame[250:475, 435:635] = small
+        writer.write(frame)
+    writer.commit()
+    status = main(["track", str(tmp_path / "edited.mp4"), "-o", str(tmp_path / "e.fap")])
+    err = capsys.readouterr().err
+    assert status == 0, err
+    assert "no face in frames 5-7 of 16; interpolated" in err
+    assert "several faces in frames 10-12; tracked the largest" in err
+    assert read_fap(tmp_path / "e.fap").n_frames == N
