@@ -44,6 +44,11 @@ def test_track_writes_fap_landmarks_and_mirror(face_video, tmp_path, capsys):
     assert np.corrcoef(jaw, np.clip(np.arange(N) - 4, 0, None))[0, 1] > 0.8
     marks = read_landmarks(tmp_path / "l.csv")
     assert marks.landmarks.shape == (N, 478, 3) and marks.fps == 25
+    # the landmarks alone give the same FAPs (up to the CSV's 1/1000 px and the .fap's
+    # integer rounding: a few units, 1e-5 rad for angles)
+    assert main(["track", str(tmp_path / "l.csv"), "-o", str(tmp_path / "again.fap"),
+                 "--neutral", "0:4"]) == 0
+    np.testing.assert_allclose(read_fap(tmp_path / "again.fap").values, stream.values, atol=6)
     info = probe_video(tmp_path / "mirror.mp4")
     assert info["frames"] == N and info["audio"]
     meta, frames = read_video(tmp_path / "mirror.mp4")
