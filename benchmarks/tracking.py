@@ -8,7 +8,9 @@ Renders ``examples/hello/hello.fdl`` (speech, expressions, gaze, blinks) at 640x
 added head turns (yaw up to 20 degrees, pitch 10, roll 8), tracks the video with MediaPipe,
 recovers the FAPs and prints: MediaPipe frames/s, landmarks-to-FAPs frames/s, and per FAP
 the correlation and gain of the recovered against the true curve, blink and lip-closure
-recall; then the same without the added head turns.
+recall; then the same without the added head turns; then both on the SOMA-X head of
+``examples/heads`` (set up with ``facelib.setup_face``), which the default head's rig
+model has never seen.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import time
 import numpy as np
 
 import facelib
-from facelib.engine import default_face
+from facelib.engine import Face, default_face
 from facelib.mpeg4 import FapStream
 from facelib.tracking.closedloop import (
     closed_loop,
@@ -34,9 +36,9 @@ from facelib.tracking.mediapipe import FaceMeshTracker
 FAPS = (3, 53, 54, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
 
 
-def report(title: str, truth: FapStream) -> None:
+def report(title: str, truth: FapStream, face: Face | None = None) -> None:
     started = time.perf_counter()
-    loop = closed_loop(truth, keep_frames=True)
+    loop = closed_loop(truth, face=face, keep_frames=True)
     print(f"\n{title}: {truth.n_frames} frames, closed loop in "
           f"{time.perf_counter() - started:.1f} s")
     print(f"  {'FAP':>3}  {'name':<22} {'corr':>6} {'gain':>6}")
@@ -47,7 +49,7 @@ def report(title: str, truth: FapStream) -> None:
         events = closure_events(truth.values[:, fap_id - 1], 600)
         recall = event_recall(events, loop.tracked.stream.values[:, fap_id - 1])
         print(f"  blinks (FAP {fap_id}): {len(events)}, recalled {recall:.0%}")
-    face = default_face()
+    face = default_face() if face is None else face
     truth_gap = lip_gap(face, truth)
     events = lip_closures(truth_gap, truth.fps)
     recall = event_recall(events, -lip_gap(face, loop.tracked.stream))
@@ -77,6 +79,10 @@ def main() -> None:
     report("hello.fdl with head turns (yaw 20, pitch 10, roll 8 degrees)",
            with_head_turns(hello))
     report("hello.fdl as scripted (small head motion)", hello)
+    soma = facelib.setup_face("examples/heads/soma_head.ply",
+                              landmarks="examples/heads/soma_landmarks.json")
+    report("SOMA-X head, hello.fdl with head turns", with_head_turns(hello), soma)
+    report("SOMA-X head, hello.fdl as scripted", hello, soma)
 
 
 if __name__ == "__main__":
