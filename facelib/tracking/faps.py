@@ -147,7 +147,11 @@ def _remove_pose(points: np.ndarray, layout: LandmarkLayout, span: slice,
 
 def _plan(layout: LandmarkLayout, pose: HeadPose | None
           ) -> list[tuple[int, int, int, float, str]]:
-    """(FAP column, point row, axis, sign, FAPU name) for every directly measured FAP."""
+    """(FAP column, point row, axis, sign, FAPU name) for every directly measured FAP.
+
+    Points that cannot move relative to the head are left out: the stable points of the
+    pose fit, or, without one, the nose tip 9.3, the seed's reference.
+    """
     stable = set(layout.stable.tolist())
     fixed = {fp for p, fp in enumerate(layout.feature_points)
              if set(np.flatnonzero(layout.weights[p]).tolist()) <= stable}
