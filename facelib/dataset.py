@@ -128,7 +128,7 @@ _SECTIONS = {
 }
 
 
-def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
+def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:  # noqa: C901, PLR0912
     """Read a dataset spec (TOML); unknown keys and bad values raise FacelibError naming
     the file."""
     where = str(path)
