@@ -50,6 +50,8 @@ _LAZY = {
     "from_arkit": "facelib.export",
     "setup_face": "facelib.engine.setup",
     "write_face": "facelib.engine.writer",
+    "landmarks_to_faps": "facelib.tracking.faps",
+    "track_video_faps": "facelib.tracking.video",
 }
 
 
@@ -93,6 +95,7 @@ __all__ = [
     "from_arkit",
     "gaze",
     "import_arkit",
+    "landmarks_to_faps",
     "load_face",
     "mpeg4",
     "plot_curves",
@@ -104,6 +107,7 @@ __all__ = [
     "setup_face",
     "sync",
     "to_arkit",
+    "track_video_faps",
     "view",
     "visemes",
     "write_face",

@@ -25,6 +25,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
+from typing import Literal
 
 import numpy as np
 
@@ -33,8 +34,16 @@ from facelib.data import json_data
 from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
 from facelib.tracking.layouts import LandmarkLayout, landmark_layout
-from facelib.tracking.pose import HeadPose, euler_angles, fit_pose, unpose
+from facelib.tracking.pose import (
+    HeadPose,
+    euler_angles,
+    fit_pose,
+    refine_pose_2d,
+    unpose,
+    unpose_2d,
+)
 from facelib.tracking.relations import apply_relations
+from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
 from facelib.tracking.userfapu import user_fapu
 
@@ -117,24 +126,32 @@ def _neutral_span(neutral: int | tuple[int, int], n: int) -> slice:
     return slice(start, stop)
 
 
-def _remove_pose(points: np.ndarray, fps: np.ndarray, layout: LandmarkLayout,
-                 span: slice) -> tuple[np.ndarray, HeadPose | None]:
-    """Feature points ``(n, P, D)`` in the neutral head's frame, and the fit."""
+def _remove_pose(points: np.ndarray, layout: LandmarkLayout, span: slice,
+                 rest_all: np.ndarray) -> tuple[np.ndarray, HeadPose | None]:
+    """All landmarks ``(n, K, D)`` in the neutral head's frame, and the fit."""
     dim = points.shape[2]
     if len(layout.stable) > dim:
         stable = points[:, layout.stable]
-        pose = fit_pose(stable[span].mean(axis=0), stable)
-        return unpose(fps, pose), pose
+        rest = rest_all[layout.stable]
+        pose = fit_pose(rest, stable)
+        if dim == 2:
+            return unpose(points, pose), pose
+        pose = refine_pose_2d(rest, stable, pose)
+        return unpose_2d(points, rest_all, pose), pose
     if "9.3" not in layout.feature_points:
         raise TrackingError("without stable points the nose tip 9.3 must be tracked "
                             "(the seed's reference point)")
-    nose = fps[:, layout.index("9.3")]
-    return fps - (nose - nose[span].mean(axis=0))[:, None, :], None
+    nose = layout.feature_point_positions(points)[:, layout.index("9.3")]
+    return points - (nose - nose[span].mean(axis=0))[:, None, :], None
 
 
 def _plan(layout: LandmarkLayout, pose: HeadPose | None
           ) -> list[tuple[int, int, int, float, str]]:
-    """(FAP column, point row, axis, sign, FAPU name) for every directly measured FAP."""
+    """(FAP column, point row, axis, sign, FAPU name) for every directly measured FAP.
+
+    Points that cannot move relative to the head are left out: the stable points of the
+    pose fit, or, without one, the nose tip 9.3, the seed's reference.
+    """
     stable = set(layout.stable.tolist())
     fixed = {fp for p, fp in enumerate(layout.feature_points)
              if set(np.flatnonzero(layout.weights[p]).tolist()) <= stable}
@@ -169,6 +186,32 @@ def _gaze(local: np.ndarray, layout: LandmarkLayout, span: slice,
         mask[:, [yaw_id - 1, pitch_id - 1]] = True
 
 
+def _fit(local: np.ndarray, span: slice, units: Mapping[str, float], model: RigModel,
+         *, values: np.ndarray, mask: np.ndarray) -> None:
+    """FAPs of ``model`` by fitting the face's rig, plus a small residual head motion, to
+    the landmark motion relative to nearby anchors (:mod:`~facelib.tracking.rigfit`)."""
+    points = local[:, model.landmarks]
+    rest = points[span].mean(axis=0)
+    found = fit_faps(model, points[..., :2] - rest[:, :2], units,
+                     rest=rest if points.shape[2] == 3 else None)
+    values[:, model.faps - 1] = found
+    mask[:, model.faps - 1] = True
+
+
+@cache
+def default_rig() -> RigModel:
+    """The default head's rig for MediaPipe's mesh landmarks (0-467, the iris excluded)."""
+    from facelib.engine import default_face
+    from facelib.tracking.embedding import default_head_embedding
+
+    layout = landmark_layout("mediapipe")
+    face = default_face()
+    on_face = layout.feature_point_positions(face.vertices[default_head_embedding()][None])[0]
+    measured = user_fapu(dict(zip(layout.feature_points, on_face, strict=True)))
+    return rig_model(face, default_head_embedding(), np.arange(468), anchors=layout.anchors,
+                     landmark_fapu=measured)
+
+
 def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     """One Euro filter on the measured columns, in FAPU0 distances and radians."""
     cols = np.flatnonzero(mask.any(axis=0))
@@ -184,6 +227,36 @@ def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     return out
 
 
+def _inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
+            rig: RigModel | Literal["auto", "default"] | None
+            ) -> tuple[np.ndarray, LandmarkLayout, RigModel | None]:
+    """Checked ``(n, K, D)`` landmarks, the layout, and the rig model to fit (or None)."""
+    data = np.asarray(landmarks, np.float64)
+    if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
+        raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
+    if isinstance(layout, str):
+        layout = landmark_layout(layout, data.shape[1])
+    if rig == "auto":
+        rig = "default" if layout.name == "mediapipe" and data.shape[2] == 3 else None
+    if rig == "default" and layout.name != "mediapipe":
+        raise ParameterError(f"rig='default' needs MediaPipe landmarks, not {layout.name!r}")
+    return data, layout, default_rig() if rig == "default" else rig
+
+
+def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
+            states: Mapping[str, np.ndarray] | None,
+            relations: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Smoothing, the floor of unidirectional FAPs, then eq. 4.17."""
+    if smooth:
+        values = _smooth(values, mask, rate)
+    for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
+        if fap.bidirectional is False and fap.min == 0:
+            values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
+    if relations or states:
+        values, mask = apply_relations(values, mask, frame_states=states)
+    return values, mask
+
+
 def measure_faps(
     landmarks: np.ndarray,
     *,
@@ -194,6 +267,7 @@ def measure_faps(
     smooth: bool = True,
     states: Mapping[str, np.ndarray] | None = None,
     relations: bool = True,
+    rig: RigModel | Literal["auto", "default"] | None = "auto",
 ) -> TrackedFaps:
     """FAPs from landmark tracks; see the module docstring for the steps.
 
@@ -209,40 +283,38 @@ def measure_faps(
     smooth: apply the One Euro filter.
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
     relations: fill untracked FAPs by eq. 4.17.
+    rig: fit this face's rig to the landmark motion (:mod:`~facelib.tracking.rigfit`) for
+        the FAPs it models, instead of eq. 4.16's one point per FAP; ``"default"`` is the
+        default head with MediaPipe landmarks (needs the ``mediapipe`` layout); ``"auto"``
+        (the default) uses it for 3-D MediaPipe landmarks and eq. 4.16 otherwise; None
+        always uses eq. 4.16.
     """
     rate = check_fps(fps)
-    data = np.asarray(landmarks, np.float64)
-    if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
-        raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
-    if isinstance(layout, str):
-        layout = landmark_layout(layout, data.shape[1])
+    data, layout, model = _inputs(landmarks, layout, rig)
     data, filled = fill_gaps(data)
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
     points = face_frame(data)
     span = _neutral_span(neutral, len(data))
-    local, pose = _remove_pose(points, layout.feature_point_positions(points), layout, span)
+    local_all, pose = _remove_pose(points, layout, span, points[span].mean(axis=0))
+    local = layout.feature_point_positions(local_all)
     rest = local[span].mean(axis=0)
     units = user_fapu(dict(zip(layout.feature_points, rest, strict=True)), fapu)
     values = np.zeros((len(data), N_FAPS))
     mask = np.zeros((len(data), N_FAPS), bool)
-    disp = local - rest
-    for col, row, axis, sign, unit in _plan(layout, pose):
-        values[:, col] = sign * disp[:, row, axis] / units[unit]
+    for col, row, axis, sign, unit in _plan(layout, pose):  # eq. 4.16, per axis
+        values[:, col] = sign * (local - rest)[:, row, axis] / units[unit]
         mask[:, col] = True
+    if model is not None:
+        _fit(local_all, span, units, model, values=values, mask=mask)
     _gaze(local, layout, span, values, mask)
     if pose is not None:
         for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
             values[:, fap_id - 1] = angle / ANGLE_UNIT
             mask[:, fap_id - 1] = True
-    if smooth:
-        values = _smooth(values, mask, rate)
-    for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
-        if fap.bidirectional is False and fap.min == 0:
-            values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
-    if relations or states:
-        values, mask = apply_relations(values, mask, frame_states=states)
+    values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
+                           relations=relations)
     return TrackedFaps(FapStream(rate, values, mask), units, pose, filled)
 
 

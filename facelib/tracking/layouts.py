@@ -7,7 +7,7 @@ data under ``facelib/data/tracking/`` (one row per point with its reason).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 
 import numpy as np
@@ -32,6 +32,8 @@ class LandmarkLayout:
     feature_points: feature point ids (``"8.3"``) in output order, P of them.
     weights: ``(P, K) float64``; row p averages the landmarks of feature point p.
     stable: ``(S,) int64`` landmark indices for the rigid head fit (may be empty).
+    anchors: ``(A,) int64`` landmark indices the rig fit measures motion against (may be
+        empty).
     """
 
     name: str
@@ -39,6 +41,7 @@ class LandmarkLayout:
     feature_points: tuple[str, ...]
     weights: np.ndarray
     stable: np.ndarray
+    anchors: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     def feature_point_positions(self, landmarks: np.ndarray) -> np.ndarray:
         """``(n_frames, K, D)`` landmarks -> ``(n_frames, P, D) float64`` feature points."""
@@ -86,12 +89,15 @@ def landmark_layout(name: str, n_points: int | None = None) -> LandmarkLayout:
     fps: list[str] = []
     rows: list[list[int]] = []
     stable: list[int] = []
+    anchors: list[int] = []
     for line, row in csv_rows(table):
         ids = _indices(row["landmarks"], count, where, line)
         if ids is None:
             continue
         if row["role"] == "stable":
             stable += ids
+        elif row["role"] == "anchor":
+            anchors += ids
         elif row["role"] == "feature_point":
             if row["name"] not in known or row["name"] in fps:
                 raise DataError(f"unknown or repeated feature point {row['name']!r}",
@@ -99,7 +105,7 @@ def landmark_layout(name: str, n_points: int | None = None) -> LandmarkLayout:
             fps.append(row["name"])
             rows.append(ids)
         else:
-            raise DataError(f"role must be feature_point or stable, got {row['role']!r}",
+            raise DataError(f"role must be feature_point, stable or anchor, got {row['role']!r}",
                             path=where, line=line)
     weights = np.zeros((len(fps), count))
     for p, ids in enumerate(rows):
@@ -107,7 +113,9 @@ def landmark_layout(name: str, n_points: int | None = None) -> LandmarkLayout:
     weights.flags.writeable = False
     stable_arr = np.array(sorted(set(stable)), np.int64)
     stable_arr.flags.writeable = False
-    return LandmarkLayout(name, count, tuple(fps), weights, stable_arr)
+    anchor_arr = np.array(sorted(set(anchors)), np.int64)
+    anchor_arr.flags.writeable = False
+    return LandmarkLayout(name, count, tuple(fps), weights, stable_arr, anchor_arr)
 
 
 def feature_point_layout(feature_points: tuple[str, ...],

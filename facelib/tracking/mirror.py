@@ -7,6 +7,7 @@ Needs the ``render`` extra (the avatar is drawn with :mod:`facelib.rendering`).
 from __future__ import annotations
 
 import os
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -18,7 +19,7 @@ from facelib.mpeg4 import FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.rendering.protocols import Deformable
 from facelib.rendering.video import open_writer
-from facelib.tracking.video import read_video
+from facelib.tracking.video import extract_audio, read_video
 
 __all__ = ["mirror_frames", "render_mirror"]
 
@@ -57,16 +58,18 @@ def render_mirror(video: str | os.PathLike[str], stream: FapStream,
     height = _even(info.height)
     width = _even(avatar_width or round(height * 4 / 3))
     face = default_face() if face is None else face
-    sound = Path(video) if info.audio and Path(out).suffix.lower() == ".mp4" else None
-    with FaceRenderer(face, width=width, height=height) as renderer:
-        writer = open_writer(out, fps=info.fps, width=_even(info.width) + width, height=height,
-                             audio=sound,
-                             duration=stream.duration)
-        try:
-            for image in mirror_frames(frames, iter_frames(renderer, face, stream),
-                                       landmarks=landmarks):
-                writer.write(image)
-        except BaseException:
-            writer.abort()
-            raise
-        return writer.commit()
+    with tempfile.TemporaryDirectory(prefix="facelib-mirror-") as scratch:
+        sound = None
+        if info.audio and Path(out).suffix.lower() == ".mp4":
+            sound = extract_audio(video, Path(scratch) / "sound.wav")
+        with FaceRenderer(face, width=width, height=height) as renderer:
+            writer = open_writer(out, fps=info.fps, width=_even(info.width) + width,
+                                 height=height, audio=sound, duration=stream.duration)
+            try:
+                for image in mirror_frames(frames, iter_frames(renderer, face, stream),
+                                           landmarks=landmarks):
+                    writer.write(image)
+            except BaseException:
+                writer.abort()
+                raise
+            return writer.commit()

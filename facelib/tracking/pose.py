@@ -14,7 +14,7 @@ import numpy as np
 
 from facelib.errors import TrackingError
 
-__all__ = ["HeadPose", "euler_angles", "fit_pose", "unpose"]
+__all__ = ["HeadPose", "euler_angles", "fit_pose", "refine_pose_2d", "unpose", "unpose_2d"]
 
 
 @dataclass(frozen=True)
@@ -63,10 +63,77 @@ def fit_pose(neutral: np.ndarray, frames: np.ndarray) -> HeadPose:
     return HeadPose(scale, rotation, translation)
 
 
+def _skew(v: np.ndarray) -> np.ndarray:
+    """``(S, 3)`` vectors -> ``(S, 3, 3)`` cross-product matrices ``[v]x``."""
+    out = np.zeros((*v.shape, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def refine_pose_2d(neutral: np.ndarray, frames: np.ndarray, pose: HeadPose, *,
+                   iterations: int = 6) -> HeadPose:
+    """Refine a 3-D pose against the image coordinates only (weak perspective).
+
+    A tracker's per-frame depth is much noisier than its ``x, y`` (MediaPipe's ``z`` moves
+    with expressions), so the neutral shape's depth is trusted and each frame's depth
+    ignored: Gauss-Newton on ``min Σ |(s R X + t)_xy - Y_xy|^2`` over rotation, scale and
+    ``x, y`` translation, for all frames at once. The depth of the translation is kept.
+
+    Parameters
+    ----------
+    neutral: ``(S, 3)`` neutral stable points; frames: ``(n, S, 3)`` (``z`` unused).
+    pose: the starting fit (:func:`fit_pose`).
+    """
+    x = np.asarray(neutral, np.float64)
+    y = np.asarray(frames, np.float64)[..., :2]
+    rot, scale, trans = pose.rotation.copy(), pose.scale.copy(), pose.translation.copy()
+    skew = _skew(x)
+    for _ in range(iterations):
+        rx = np.einsum("nij,sj->nsi", rot, x)
+        resid = (scale[:, None, None] * rx[..., :2] + trans[:, None, :2]) - y
+        d_rot = -scale[:, None, None, None] * np.einsum("nij,sjk->nsik", rot, skew)[..., :2, :]
+        jac = np.concatenate([d_rot, rx[..., :2, None], np.broadcast_to(
+            np.eye(2), (*rx.shape[:2], 2, 2))], axis=3)  # (n, S, 2, 6)
+        jac = jac.reshape(len(y), -1, 6)
+        step = np.linalg.solve(np.einsum("nki,nkj->nij", jac, jac) + 1e-9 * np.eye(6),
+                               -np.einsum("nki,nk->ni", jac, resid.reshape(len(y), -1))[..., None]
+                               )[..., 0]
+        w = step[:, :3]
+        angle = np.linalg.norm(w, axis=1)
+        axis = w / np.where(angle > 0, angle, 1.0)[:, None]
+        k = _skew(axis)
+        exp = (np.eye(3) + np.sin(angle)[:, None, None] * k
+               + (1 - np.cos(angle))[:, None, None] * (k @ k))
+        rot = rot @ exp
+        scale = scale + step[:, 3]
+        trans[:, :2] += step[:, 4:]
+    return HeadPose(scale, rot, trans)
+
+
 def unpose(points: np.ndarray, pose: HeadPose) -> np.ndarray:
     """``(n, P, D)`` points -> the neutral head's frame: ``R^T (p - t) / s``."""
     moved = np.asarray(points, np.float64) - pose.translation[:, None, :]
     return np.einsum("npi,nij->npj", moved, pose.rotation) / pose.scale[:, None, None]
+
+
+def unpose_2d(points: np.ndarray, rest: np.ndarray, pose: HeadPose) -> np.ndarray:
+    """``(n, K, 3)`` points -> the neutral head's frame from their image ``x, y`` only.
+
+    Each point is taken to sit at its neutral position ``rest`` ``(K, 3)`` plus a motion in
+    the face's x-y plane, seen through the weak-perspective pose: the image offset from
+    where the neutral point would appear, ``p - (s R X + t)``, divided by ``s R[:2, :2]``.
+    The tracker's per-frame depth is never used (see :func:`refine_pose_2d`).
+    """
+    rest = np.asarray(rest, np.float64)
+    predicted = (pose.scale[:, None, None] * np.einsum("nij,kj->nki", pose.rotation, rest)
+                 + pose.translation[:, None, :])
+    offset = np.asarray(points, np.float64)[..., :2] - predicted[..., :2]
+    block = pose.scale[:, None, None] * pose.rotation[:, :2, :2]
+    local = np.broadcast_to(rest, np.shape(points)).copy()
+    local[..., :2] += np.einsum("nij,nkj->nki", np.linalg.inv(block), offset)
+    return local
 
 
 def euler_angles(rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

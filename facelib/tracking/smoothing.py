@@ -19,7 +19,7 @@ def _alpha(cutoff: np.ndarray | float, dt: float) -> np.ndarray:
     return 1.0 / (1.0 + tau / dt)
 
 
-def one_euro(signal: np.ndarray, *, fps: float, min_cutoff: float = 1.5, beta: float = 0.5,
+def one_euro(signal: np.ndarray, *, fps: float, min_cutoff: float = 4.0, beta: float = 1.0,
              d_cutoff: float = 1.0) -> np.ndarray:
     """Filter ``(n_frames, C)`` signals sampled at ``fps``; returns ``(n_frames, C) float64``.
 

@@ -9,6 +9,7 @@ are named too.
 from __future__ import annotations
 
 import os
+import subprocess
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -22,7 +23,8 @@ from facelib.errors import MissingExtraError, TrackingError, TrackingWarning
 from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 
-__all__ = ["VideoInfo", "VideoTrack", "read_video", "track_video", "track_video_faps"]
+__all__ = ["VideoInfo", "VideoTrack", "extract_audio", "read_video", "track_video",
+           "track_video_faps"]
 
 
 @dataclass(frozen=True)
@@ -97,6 +99,20 @@ def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.nda
             reader.close()
 
     return info, frames()
+
+
+def extract_audio(video: str | os.PathLike[str], wav: str | os.PathLike[str]) -> Path:
+    """Decode the first audio stream of ``video`` into the 16-bit PCM WAV ``wav`` with the
+    bundled ffmpeg (for muxing it into the mirror video). TrackingError if it fails."""
+    exe = _imageio_ffmpeg().get_ffmpeg_exe()
+    done = subprocess.run(
+        [exe, "-nostdin", "-hide_banner", "-loglevel", "error", "-y", "-i", str(video),
+         "-map", "0:a:0", "-vn", "-c:a", "pcm_s16le", "-f", "wav", str(wav)],
+        capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        message = (done.stderr.strip().splitlines() or ["ffmpeg failed"])[-1]
+        raise TrackingError(f"cannot extract its audio: {message}", path=Path(video))
+    return Path(wav)
 
 
 def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,

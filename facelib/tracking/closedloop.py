@@ -1,0 +1,152 @@
+"""The closed loop: render a face with a known FAP stream, track the render, compare.
+
+The check of the whole performance-driven path on any face (the default head, or your own
+face definition): MediaPipe sees the rendered video as it would see a person, and the
+recovered FAPs are compared with the ones that drove the render, curve by curve (Pearson
+correlation and least-squares gain), blink by blink and lip closure by lip closure.
+Needs the ``render`` and ``track`` extras.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from facelib.checks import check_count
+from facelib.engine import Face, default_face
+from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
+from facelib.rendering import FaceRenderer, iter_frames
+from facelib.tracking.faps import TrackedFaps, measure_faps
+from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+
+__all__ = ["ClosedLoop", "closed_loop", "closure_events", "event_recall", "lip_closures",
+           "lip_gap", "with_head_turns", "with_neutral_lead"]
+
+BLINK_FAPS = (19, 20)
+"""Upper-lid FAPs whose peaks are blinks."""
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """The outcome of :func:`closed_loop`.
+
+    Attributes
+    ----------
+    truth: the stream that drove the render.
+    tracked: what tracking recovered (same frame count).
+    landmarks: ``(n, 478, 3)`` MediaPipe landmarks of the render.
+    frames: ``(n, H, W, 3) uint8`` the rendered frames (None unless ``keep_frames``).
+    """
+
+    truth: FapStream
+    tracked: TrackedFaps
+    landmarks: np.ndarray
+    frames: np.ndarray | None
+
+    def correlation(self, fap_id: int) -> float:
+        """Pearson correlation of the true and recovered curves of FAP ``fap_id`` (NaN if
+        either is constant)."""
+        a = self.truth.values[:, fap_id - 1].astype(np.float64)
+        b = self.tracked.stream.values[:, fap_id - 1].astype(np.float64)
+        if a.std() == 0 or b.std() == 0:
+            return float("nan")
+        return float(np.corrcoef(a, b)[0, 1])
+
+    def gain(self, fap_id: int) -> float:
+        """Least-squares slope of recovered on true values (1 = right amplitude)."""
+        a = self.truth.values[:, fap_id - 1].astype(np.float64)
+        b = self.tracked.stream.values[:, fap_id - 1].astype(np.float64)
+        a = a - a.mean()
+        return float((a @ (b - b.mean())) / (a @ a)) if a @ a > 0 else float("nan")
+
+
+def with_head_turns(stream: FapStream, *, frames: int | None = None) -> FapStream:
+    """``stream`` (cut to ``frames``) with head pitch/yaw/roll replaced by slow sweeps that
+    grow over the first second to 10, 20 and 8 degrees (periods 3.1, 4.0, 5.3 s)."""
+    values = np.array(stream.values[:frames])
+    mask = np.array(stream.mask[:frames])
+    t = np.arange(len(values)) / stream.fps
+    ramp = np.clip(t, 0, 1)
+    for fap_id, degrees, period in ((48, 10, 3.1), (49, 20, 4.0), (50, 8, 5.3)):
+        sweep = np.radians(degrees) * np.sin(2 * np.pi * t / period)
+        values[:, fap_id - 1] = ramp * sweep / ANGLE_UNIT
+        mask[:, fap_id - 1] = True
+    return FapStream(stream.fps, values, mask)
+
+
+def with_neutral_lead(stream: FapStream, frames: int) -> FapStream:
+    """``stream`` with ``frames`` neutral frames (all FAPs 0) in front: the neutral span."""
+    check_count("frames", frames)
+    lead = FapStream(stream.fps, np.zeros((frames, N_FAPS), np.float32),
+                     np.zeros((frames, N_FAPS), bool))
+    body = FapStream(stream.fps, stream.values, stream.mask)
+    return FapStream.concat([lead, body])
+
+
+def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: int = 8,
+                width: int = 640, height: int = 480, keep_frames: bool = False,
+                **options: Any) -> ClosedLoop:
+    """Render ``face`` (default head) driven by ``stream`` after ``neutral_frames`` neutral
+    frames, track it with MediaPipe and recover the FAPs (``options`` go to
+    :func:`~facelib.tracking.faps.measure_faps`). The lead frames are cut from the result.
+    """
+    face = default_face() if face is None else face
+    full = with_neutral_lead(stream, neutral_frames)
+    rendered: list[np.ndarray] = []
+    points = np.full((full.n_frames, N_LANDMARKS, 3), np.nan)
+    with FaceRenderer(face, width=width, height=height) as renderer, \
+            FaceMeshTracker(video=True, max_faces=1) as tracker:
+        for i, image in enumerate(iter_frames(renderer, face, full)):
+            found = tracker.detect(image)
+            if found is not None:
+                points[i] = found.points
+            if keep_frames:
+                rendered.append(image)
+    tracked = measure_faps(points, fps=stream.fps, neutral=(0, max(neutral_frames, 1)),
+                           **options)
+    cut = slice(neutral_frames, None)
+    trimmed = TrackedFaps(tracked.stream[cut], tracked.fapu, tracked.pose,
+                          tuple(f - neutral_frames for f in tracked.filled_frames
+                                if f >= neutral_frames))
+    return ClosedLoop(FapStream(stream.fps, stream.values, stream.mask), trimmed, points[cut],
+                      np.stack(rendered)[cut] if keep_frames else None)
+
+
+def closure_events(signal: np.ndarray, threshold: float) -> list[tuple[int, int]]:
+    """Runs ``[start, stop)`` of frames where ``signal`` ``(n,)`` is above ``threshold``."""
+    above = np.concatenate([[False], np.asarray(signal) > threshold, [False]])
+    edges = np.flatnonzero(np.diff(above.astype(np.int8)))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+
+
+def event_recall(events: list[tuple[int, int]], recovered: np.ndarray, *,
+                 slack: int = 2) -> float:
+    """Share of ``events`` during which ``recovered`` ``(n,)`` rises above half its own
+    range above its median (within ``slack`` frames). NaN if there are no events."""
+    if not events:
+        return float("nan")
+    rec = np.asarray(recovered, np.float64)
+    base = float(np.median(rec))
+    threshold = base + 0.5 * (float(rec.max()) - base)
+    hits = sum(rec[max(a - slack, 0): b + slack].max() > threshold for a, b in events)
+    return hits / len(events)
+
+
+def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
+    """``(n,) float64`` vertical gap between the inner lip midpoints 2.2 and 2.3 of ``face``
+    deformed by ``stream``, in units of the face's MNS0 (0 = lips touching)."""
+    top, bottom = face.feature_points["2.2"], face.feature_points["2.3"]
+    moved = face.deform(stream)
+    return (moved[:, top, 1] - moved[:, bottom, 1]).astype(np.float64) / (
+        face.fapu["MNS"] * 1024)
+
+
+def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
+                 longest: float = 0.4) -> list[tuple[int, int]]:
+    """Runs ``[start, stop)`` where the lips close (``gap`` below ``closed`` MNS0) for at
+    most ``longest`` seconds between open frames: the closures of p, b and m in speech
+    (rests between phrases are longer and are left out)."""
+    runs = closure_events(-np.asarray(gap), -closed)
+    return [(a, b) for a, b in runs if a > 0 and b < len(gap) and (b - a) / fps <= longest]
