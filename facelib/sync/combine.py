@@ -27,8 +27,11 @@ _UPPER_LIDS = (fap("close_t_l_eyelid").index, fap("close_t_r_eyelid").index)
 _LOWER_LIDS = (fap("close_b_l_eyelid").index, fap("close_b_r_eyelid").index)
 
 
-def blend(a: FapTrack, b: FapTrack, *, weight_a: float, weight_b: float) -> FapTrack:
+def blend(a: FapTrack, b: FapTrack, *, weight_a: float | np.ndarray,
+          weight_b: float | np.ndarray) -> FapTrack:
     """Weighted blend of two tracks.
+
+    weight_a, weight_b: one weight for every FAP, or ``(84,)`` arrays of per-FAP weights.
 
     Per frame and FAP: ``(wa*A + wb*B) / (wa + wb)`` with ``wa = weight_a * a.weight`` and
     ``wb = weight_b * b.weight``. Where only one track drives a FAP, its value is kept as
@@ -125,7 +128,8 @@ def combine(
     speaking: ``(n_frames,) bool`` where the character talks (livelier head noise).
     """
     rules = rules or SyncRules.load()
-    face = blend(expressions, visemes, weight_a=rules.mouth[0], weight_b=rules.mouth[1])
+    mouth_e, mouth_v = rules.mouth_weights()
+    face = blend(expressions, visemes, weight_a=mouth_e, weight_b=mouth_v)
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
     if blinks is not None:
         face = close_lids(face, blinks, closed=blink_lids)

@@ -10,7 +10,10 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
+import numpy as np
+
 from facelib.errors import ParameterError
+from facelib.mpeg4.tables import N_FAPS, fap
 
 __all__ = ["HeadNoise", "SyncRules"]
 
@@ -33,16 +36,26 @@ class SyncRules:
     """Weights of the conflict resolution.
 
     mouth: (expression, viseme) weights where both drive a FAP; (1, 3) is eq. 4.11.
+    mouth_faps: FAP name -> (expression, viseme) weights that replace ``mouth`` on that FAP.
     eyes_head: (expression, gaze) weights on eyelids and head; (0.75, 0.25) in the thesis.
     expression_importance, viseme_importance: name -> factor in [0, 1] on that side's weight.
     head_noise: idle head motion, or None for none.
     """
 
     mouth: tuple[float, float] = (1.0, 3.0)
+    mouth_faps: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     eyes_head: tuple[float, float] = (0.75, 0.25)
     expression_importance: Mapping[str, float] = field(default_factory=dict)
     viseme_importance: Mapping[str, float] = field(default_factory=dict)
     head_noise: HeadNoise | None = HeadNoise()
+
+    def mouth_weights(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per-FAP (expression, viseme) weights of the mouth blend: two ``(84,) float64``
+        arrays, ``mouth`` everywhere except on the FAPs that ``mouth_faps`` names."""
+        weights = np.tile(np.asarray(self.mouth, np.float64), (N_FAPS, 1))
+        for name, pair in self.mouth_faps.items():
+            weights[fap(name).index] = pair
+        return weights[:, 0], weights[:, 1]
 
     @classmethod
     def load(cls, path: str | Path | None = None) -> SyncRules:
@@ -57,6 +70,7 @@ class SyncRules:
             noise = data.get("head_noise")
             rules = cls(
                 mouth=(float(data["mouth"]["expression"]), float(data["mouth"]["viseme"])),
+                mouth_faps=MappingProxyType(_mouth_faps(data.get("mouth_faps", []))),
                 eyes_head=(float(data["eyes_head"]["expression"]),
                            float(data["eyes_head"]["gaze"])),
                 expression_importance=MappingProxyType(
@@ -81,6 +95,21 @@ class SyncRules:
             if not 0.0 <= value <= 1.0:
                 raise ParameterError(f"importance of {name!r} is {value}, not in [0, 1]",
                                      path=where)
-        if min(*rules.mouth, *rules.eyes_head) < 0:
+        per_fap = [w for pair in rules.mouth_faps.values() for w in pair]
+        if min(*rules.mouth, *rules.eyes_head, *per_fap) < 0:
             raise ParameterError("blend weights must not be negative", path=where)
         return rules
+
+
+def _mouth_faps(groups: list[dict[str, Any]]) -> dict[str, tuple[float, float]]:
+    """``mouth_faps`` groups (``faps``, ``expression``, ``viseme``, ``why``) -> FAP name ->
+    (expression, viseme); a FAP named twice or not a FAP is an error."""
+    out: dict[str, tuple[float, float]] = {}
+    for group in groups:
+        pair = (float(group["expression"]), float(group["viseme"]))
+        for name in group["faps"]:
+            fap(name)  # raises on an unknown name
+            if name in out:
+                raise ValueError(f"FAP {name!r} is in two mouth_faps groups")
+            out[name] = pair
+    return out

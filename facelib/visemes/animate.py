@@ -24,6 +24,7 @@ from facelib.visemes.coarticulation import (
 )
 from facelib.visemes.mapping import with_visemes
 from facelib.visemes.scripts import visemes_from_cues
+from facelib.visemes.tables import timing_rules
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
 __all__ = ["VisemeAnimation", "align", "animate", "speech_timeline", "timeline_from_text"]
@@ -90,18 +91,23 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0) -> VisemeAnima
     """Mouth, jaw and tongue FAP curves for ``speech``.
 
     Frame i of the track is at ``i / fps`` s of the storyboard; the track ends at the last
-    frame inside the speech. Values come from the coarticulation blend of the viseme
-    targets; weights are the speech envelope on the driven FAPs (0 elsewhere).
+    frame of the envelope's release ramp after the speech. Values come from the
+    coarticulation blend of the viseme targets, faded to neutral with the speech
+    envelope, which is also the weight on the driven FAPs (0 elsewhere): weights and
+    values fade together, so where the viseme track alone drives a FAP it eases out
+    instead of dropping to 0 in one frame.
     ``rate`` is the speaking rate of the text-only duration model.
     """
     fps = check_fps(fps)
     timeline = speech_timeline(speech, rate=rate).shifted(speech.start_ms)
-    end_ms = speech.start_ms + timeline.duration_ms
+    # through the envelope's release ramp, so the mouth is seen settling back to neutral
+    end_ms = speech.start_ms + timeline.duration_ms + timing_rules()["envelope_ramp_ms"]
     n_frames = math.floor(end_ms * fps / 1000) + 1
     times = frame_times_ms(n_frames, fps)
-    values = blend(timeline.visemes, times)
+    env = envelope(timeline.visemes, times)
+    values = blend(timeline.visemes, times) * env[:, None]
     weight = np.zeros_like(values)
-    weight[:, driven_faps()] = envelope(timeline.visemes, times)[:, None]
+    weight[:, driven_faps()] = env[:, None]
     speaking = speaking_mask(timeline.visemes, times)
     speaking.flags.writeable = False
     return VisemeAnimation(FapTrack(fps, values, weight), timeline.visemes, speaking, timeline)

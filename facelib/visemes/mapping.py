@@ -62,24 +62,32 @@ def merge_short_silences(
 
 
 def enforce_min_duration(
-    visemes: Sequence[VisemeSpan], *, min_ms: int | None = None
+    visemes: Sequence[VisemeSpan], *, min_ms: int | None = None, merge_below_ms: int | None = None
 ) -> tuple[VisemeSpan, ...]:
     """Lengthen spans shorter than ``min_ms`` (default: the data file's ``min_visible_ms``)
     by taking time from neighbours that can spare it (they stay at least ``min_ms`` long).
-    A span that still cannot be seen is merged into its longer neighbour, except a
-    bilabial (p b m), whose closure must show: its neighbour gives way instead."""
-    min_len = timing_rules()["min_visible_ms"] if min_ms is None else min_ms
+    A span that still falls short keeps the time it has, so the dominance blend leaves a
+    visible trace of it; only one shorter than ``merge_below_ms`` (default: the data file's
+    ``merge_below_ms``, the aligner's noise) is merged into its longer neighbour, and never
+    a bilabial (p b m), whose closure must show: its neighbour gives way instead."""
+    rules = timing_rules()
+    min_len = rules["min_visible_ms"] if min_ms is None else min_ms
+    merge_below = rules["merge_below_ms"] if merge_below_ms is None else merge_below_ms
     out = list(visemes)
+    settled: set[tuple[int, int]] = set()
     changed = True
     while changed:
         changed = False
-        for i, span in enumerate(out):
-            need = min_len - span.duration_ms
-            if need <= 0 or len(out) == 1:
+        for i in range(len(out)):
+            need = min_len - out[i].duration_ms
+            if need <= 0 or len(out) == 1 or (out[i].start_ms, out[i].end_ms) in settled:
                 continue
             need = _borrow(out, i, need, min_len)
-            if need > 0:
+            grown = out[i]  # after borrowing
+            if grown.duration_ms < merge_below:
                 _merge(out, i)
+            elif need > 0:
+                settled.add((grown.start_ms, grown.end_ms))
             changed = True
             break
     return tuple(out)
