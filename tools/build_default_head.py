@@ -22,12 +22,16 @@ What it does:
    (the renderer has no ambient occlusion);
 4. places the MPEG-4 feature points with geometric rules, helped by the ARKit face targets of
    the same wheel (which vertices a jaw opening, a blink, a brow raise moves);
-5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots.
+5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots;
+6. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
+   fap_targets.csv`` names (the ``field`` deformer): stored in the mesh file as
+   ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex.
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import io
 import json
 import zipfile
@@ -537,6 +541,7 @@ def build(wheel_path: Path) -> None:
     skin_c[inside] = np.array(MOUTH) * (1.0 - (1.0 - MOUTH_DEEP) * depth)
     cols[:n_skin] = skin_c
 
+    field_regions, fields = learned_fields(pos, fp, skin_target=skin_target, n_skin=n_skin)
     regions = make_regions(
         pos,
         skin,
@@ -547,7 +552,7 @@ def build(wheel_path: Path) -> None:
         mouth_y=mouth_y,
         x_corner=x_corner,
         eyes={s: (m(eyes[s][0]), eyes[s][1] * SCALE) for s in ("l", "r")},
-    )
+    ) + field_regions
 
     pivots = {
         "eye_l": m(eyes["l"][0]).tolist(),
@@ -583,6 +588,7 @@ def build(wheel_path: Path) -> None:
         vertices=verts.astype(np.float32),
         triangles=tris.astype(np.int32),
         vertex_colors=np.round(cols * 255).astype(np.uint8),
+        **fields,
     )
     (OUT_DIR / "default_head.json").write_text(json.dumps(definition, indent=1) + "\n")
     print(
@@ -760,6 +766,47 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
             }
         )
     return regions
+
+
+FIELD_BLEND = 0.006  # metres each side of the midline over which a one-sided field fades
+FIELD_MIN = 1e-5  # metres: displacements below this (at target weight 1) are dropped
+
+
+def fap_target_rows() -> list[dict[str, str]]:
+    path = ROOT / "facelib" / "data" / "head" / "fap_targets.csv"
+    lines = [ln for ln in path.read_text("utf-8").splitlines() if not ln.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+def learned_fields(pos, fp, *, skin_target, n_skin):
+    """One ``field`` region per row of fap_targets.csv, and its ``(Vr, 3)`` float32 array."""
+    from facelib.mpeg4.tables import fap as fap_info
+
+    regions, arrays = [], {}
+    x = pos[:n_skin, 0]
+    for row in fap_target_rows():
+        info = fap_info(row["fap"])
+        field = np.zeros((n_skin, 3))
+        for term in row["targets"].split("+"):
+            scale, _, name = term.rpartition("*")
+            field += float(scale or 1.0) * skin_target(name.strip(), vectors=True)
+        if row["side"] != "both":
+            sgn = 1.0 if row["side"] == "left" else -1.0
+            t = np.clip((sgn * x + FIELD_BLEND) / (2 * FIELD_BLEND), 0.0, 1.0)
+            field *= (t * t * (3 - 2 * t))[:, None]
+        point = fp[info.feature_points[0]]
+        members = np.nonzero(np.linalg.norm(field, axis=1) > FIELD_MIN)[0]
+        along = float(field[point] @ np.asarray(info.direction))
+        share = abs(along) / max(float(np.linalg.norm(field[point])), 1e-12)
+        print(f"field {info.name}: {len(members)} vertices, feature point moves "
+              f"{1000 * np.linalg.norm(field[point]):.1f} mm, {share:.0%} along the FAP")
+        key = f"field_{info.name}"
+        arrays[key] = field[members].astype(np.float32)
+        regions.append({"name": key, "deformer": "field",
+                        "feature_points": [info.feature_points[0]], "fap": info.name,
+                        "field": key, "targets": row["targets"],
+                        "note": row["note"], "vertices": members.tolist()})
+    return regions, arrays
 
 
 def main() -> None:

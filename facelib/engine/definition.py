@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 
 from facelib.engine.face import DEFORMERS, PART_NAMES, Face, Region
-from facelib.errors import FaceModelError
-from facelib.mpeg4.tables import fap_table, feature_point_table
+from facelib.errors import FacelibError, FaceModelError
+from facelib.mpeg4.tables import fap, fap_table, feature_point_table
 
 __all__ = ["FORMAT", "VERSION", "load_face", "required_feature_points"]
 
@@ -72,6 +72,7 @@ class _Reader:
     def __init__(self, path: Path, doc: Any):
         self.path = path
         self.doc = doc
+        self.fields: dict[str, np.ndarray] = {}  # the mesh file's field_* arrays
 
     def fail(self, message: str) -> FaceModelError:
         return FaceModelError(message, path=self.path)
@@ -109,6 +110,7 @@ class _Reader:
         try:
             with np.load(mesh_path, allow_pickle=False) as data:
                 arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
+                self.fields = {k: data[k] for k in data.files if k.startswith("field_")}
         except (OSError, ValueError) as exc:
             raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
         except KeyError as exc:
@@ -193,6 +195,26 @@ class _Reader:
             raise self.fail(f"neck normal {raw['normal']!r} and blend {blend!r} must be nonzero")
         return point, normal / length, blend
 
+    def field(self, item: dict[str, Any], where: str, controls: list[str],
+              n_members: int) -> tuple[str, np.ndarray]:
+        """A ``field`` region's FAP name and ``(Vr, 3)`` displacements from the mesh file."""
+        try:
+            info = fap(str(item.get("fap")))
+        except FacelibError as exc:
+            raise self.fail(f"{where}: a field region names the FAP it drives, got "
+                            f"{item.get('fap')!r}") from exc
+        if info.kind != "translation" or list(info.feature_points[:1]) != controls:
+            raise self.fail(f"{where}: field FAP {info.name} moves {info.feature_points}, "
+                            f"not the region's feature points {controls}")
+        key = item.get("field")
+        if not isinstance(key, str) or key not in self.fields:
+            raise self.fail(f"{where}: the mesh file has no field array {key!r}")
+        array = np.asarray(self.fields[key], dtype=np.float32)
+        if array.shape != (n_members, 3) or not np.all(np.isfinite(array)):
+            raise self.fail(f"{where}: field {key!r} must be finite ({n_members}, 3), got "
+                            f"{array.shape}")
+        return info.name, array
+
     def regions(self, nv: int, fps: dict[str, int], pivots: dict[str, np.ndarray]) -> tuple:
         raw = self.get("regions", list)
         out, names = [], set()
@@ -231,7 +253,11 @@ class _Reader:
                 pivot = item.get("pivot")
                 if pivot not in pivots:
                     raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
+            fap_name, displacements = "", np.zeros((0, 3), np.float32)
+            if deformer == "field":
+                fap_name, displacements = self.field(item, where, controls, vertices.size)
             out.append(Region(name=name, deformer=deformer, feature_points=tuple(controls),
                               vertices=vertices, anchors=anchors,
-                              weights=weights.astype(np.float32), pivot=pivot))
+                              weights=weights.astype(np.float32), pivot=pivot,
+                              fap=fap_name, displacements=displacements))
         return tuple(out)

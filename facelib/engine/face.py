@@ -29,6 +29,7 @@ import scipy.sparse as sp
 from facelib.engine import rigid
 from facelib.engine.deformers import explicit_weights, raised_cosine_weights, rbf_weights
 from facelib.engine.fapu import compute_fapu
+from facelib.engine.fields import field_weights
 from facelib.errors import FaceModelError, ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
@@ -37,7 +38,7 @@ __all__ = ["PART_NAMES", "Face", "Part", "Region"]
 
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
 LINEAR_DEFORMERS = ("cosine", "rbf", "weights")
-DEFORMERS = (*LINEAR_DEFORMERS, "eyelid")
+DEFORMERS = (*LINEAR_DEFORMERS, "field", "eyelid")
 _EYELID_FAPS = {"3.1": 19, "3.2": 20, "3.3": 21, "3.4": 22}
 _EYES = (("eye_l", 23, 25, 27), ("eye_r", 24, 26, 28))
 _BLOCK = 32  # frames deformed together
@@ -69,12 +70,16 @@ class Region:
 
     name: unique name.
     deformer: ``"cosine"`` (eq. 4.7), ``"rbf"`` (eq. 4.8-4.10), ``"weights"`` (explicit
-        per-vertex weights of one feature point) or ``"eyelid"`` (rotation over the eye).
+        per-vertex weights of one feature point), ``"field"`` (a learned displacement
+        field that alone drives one FAP, see :mod:`facelib.engine.fields`) or ``"eyelid"``
+        (rotation over the eye).
     feature_points: ids of the controlling feature points.
     vertices: (Vr,) int32 member vertices (the ones that move).
     anchors: (A,) int32 static border vertices (RBF only; empty otherwise).
     weights: (Vr,) float32 (``weights`` and ``eyelid`` only; empty otherwise).
     pivot: pivot name (``eyelid`` only).
+    fap: the FAP name a ``field`` region drives ("" otherwise).
+    displacements: (Vr, 3) float32 target displacements of the members (``field`` only).
     """
 
     name: str
@@ -84,6 +89,8 @@ class Region:
     anchors: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
     weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
     pivot: str = ""
+    fap: str = ""
+    displacements: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
 
 
 def _columns(ids: np.ndarray, axes: str = "xyz") -> np.ndarray:
@@ -254,6 +261,25 @@ class Face:
     def n_vertices(self) -> int:
         return int(self.vertices.shape[0])
 
+    @property
+    def fap_deformers(self) -> Mapping[str, str]:
+        """FAP name -> the deformer kind that moves its feature point's surroundings:
+        ``"field"`` where a learned field drives the FAP, else the kinds of the regions
+        its feature point controls (joined by ``+``); FAPs that move no region are left out."""
+        out: dict[str, str] = {}
+        fields = {r.fap: r.deformer for r in self.regions if r.deformer == "field"}
+        for f in fap_table():
+            if f.name in fields:
+                out[f.name] = "field"
+                continue
+            if f.kind != "translation" or not f.feature_points:
+                continue
+            kinds = sorted({r.deformer for r in self.regions if r.deformer != "field"
+                            and f.feature_points[0] in r.feature_points})
+            if kinds:
+                out[f.name] = "+".join(kinds)
+        return MappingProxyType(out)
+
     def deform(self, stream: FapStream) -> np.ndarray:
         """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``."""
         if not isinstance(stream, FapStream):
@@ -378,6 +404,7 @@ def _compile(
         for k, fp_id in enumerate(region.feature_points):
             keep = w[:, k] != 0
             carried.setdefault(fp_id, []).append((members[keep], w[keep, k]))
+    fields = {fap(r.fap).index: r for r in regions if r.deformer == "field"}
     rows, cols, vals = [], [], []
     for f in fap_table():
         if f.kind != "translation" or f.fapu not in fapu or f.id in _EYELID_FAPS.values():
@@ -385,7 +412,22 @@ def _compile(
         if f.id in (27, 28):  # eyeball thrust moves the whole eye (rigid step)
             continue
         fp_id = f.feature_points[0]
-        scale = fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
+        direction = np.asarray(f.direction, dtype=np.float64)
+        if f.index in fields:  # a learned field replaces the regions for this FAP
+            region = fields[f.index]
+            members = region.vertices.astype(np.int64)
+            at = np.flatnonzero(members == fps[fp_id])
+            if at.size != 1:
+                raise FaceModelError(f"field region {region.name!r} must contain its feature "
+                                     f"point {fp_id} (vertex {fps[fp_id]})")
+            w3 = field_weights(region.displacements, int(at[0]), direction, fapu[f.fapu],
+                               name=region.name)
+            for axis in range(3):
+                rows.append(np.full(members.size, f.index))
+                cols.append(members * 3 + axis)
+                vals.append(w3[:, axis])
+            continue
+        scale = fapu[f.fapu] * direction
         for members, w in carried.get(fp_id, ()):
             for axis in range(3):
                 if scale[axis] == 0:

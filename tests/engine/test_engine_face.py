@@ -99,13 +99,19 @@ def test_translation_fap_moves_its_point(face: Face, fap_id: int) -> None:
         centre = face.pivots["eye_l" if fap_id in (19, 21) else "eye_r"]
         assert np.linalg.norm(moved[p] - centre) == pytest.approx(
             np.linalg.norm(rest[p] - centre), rel=1e-5)
+    elif face.fap_deformers.get(f.name) == "field":
+        # eq. 4.6 exactly along the FAP's direction; the learned field decides the rest
+        direction = np.asarray(f.direction, dtype=np.float64)
+        assert delta @ direction == pytest.approx(expected @ direction, rel=1e-4)
     else:
         assert delta == pytest.approx(expected, rel=0.01, abs=1e-3 * np.abs(expected).max())
     # far from the feature point nothing moves (but the jaw carries teeth and tongue)
     far = np.linalg.norm(rest - rest[p], axis=1) > 0.09
     if fap_id in (3, 14, 15):
         far[face.parts["teeth_lower"].vertex_ids] = far[face.parts["tongue"].vertex_ids] = False
-    assert np.abs(moved[far] - rest[far]).max() < 1e-7
+    # a learned field may reach further (a brow lowerer folds the forehead), but fades there
+    limit = 0.1 * np.linalg.norm(delta) if face.fap_deformers.get(f.name) == "field" else 1e-7
+    assert np.abs(moved[far] - rest[far]).max() < limit
 
 
 def test_deformation_is_linear_in_translation_faps(face: Face) -> None:
