@@ -9,8 +9,10 @@ Deformation of one frame ``f`` (84 FAP values):
 2. eyelids (FAP 19-22) rotate over the eyeball about the eye centre, by the angle that
    moves their feature point vertically by ``f_j * IRISD``, each vertex by its weight;
 3. eyeballs rotate about their centres (FAP 23-26) and move forward (FAP 27-28);
-4. lower teeth and tongue follow the jaw: a hinge rotation that drops the chin point 2.1 by
-   ``f_3 * MNS`` plus the thrust (FAP 14) and shift (FAP 15) translations;
+4. lower teeth and tongue follow the jaw: a hinge rotation that moves the lower-lip point
+   2.3 vertically as the skin operator moves it per unit of FAP 3 (so the lower teeth stay
+   behind the lower lip, whatever deformer opens the jaw; with a plain jaw region that is the
+   chin's drop of ``f_3 * MNS``) plus the thrust (FAP 14) and shift (FAP 15) translations;
 5. the head rotates about its pivot (FAP 48-50), fading to nothing over the neck.
 
 FAPs 1-2 (high-level visemes and expressions, expanded by the generators), 29-30 (pupil
@@ -136,7 +138,8 @@ class _Rigid:
     jaw_y: np.ndarray
     jaw_z: np.ndarray
     jaw_pivot: np.ndarray
-    chin: np.ndarray
+    chin: np.ndarray  # the point the hinge follows (2.3, the lower lip)
+    chin_drop: float  # its downward motion per unit of FAP 3 in the skin operator
     head_pivot: np.ndarray
     head_tiled: np.ndarray  # (3V,) float32, the pivot repeated per vertex
     head_weights: np.ndarray  # (K,) float32 for the neck vertices
@@ -236,7 +239,8 @@ class Face:
             jaw_y=_columns(jaw_ids, "y"),
             jaw_z=_columns(jaw_ids, "z"),
             jaw_pivot=pivot_map["jaw"],
-            chin=verts[fps["2.1"]].astype(np.float64),
+            chin=verts[fps["2.3"]].astype(np.float64),
+            chin_drop=_jaw_drop(operator, fps["2.3"], fapu["MNS"]),
             head_pivot=head,
             head_tiled=np.tile(head.astype(np.float32), len(verts)),
             head_weights=head_w[head_w < 1.0].astype(np.float32),
@@ -346,7 +350,7 @@ class Face:
         if not (open_.any() or thrust.any() or shift.any()):
             return
         flat = pos.reshape(len(f), -1)
-        angle = rigid.hinge_angle(r.chin, r.jaw_pivot, -open_ * self.fapu["MNS"])
+        angle = rigid.hinge_angle(r.chin, r.jaw_pivot, -open_ * r.chin_drop)
         y, z = rigid.rotate_about_x(flat[:, r.jaw_y], flat[:, r.jaw_z], r.jaw_pivot[1],
                                     r.jaw_pivot[2], angle[:, None])
         flat[:, r.jaw_y] = y
@@ -370,6 +374,13 @@ class Face:
         out.reshape(nb, -1)[:] += r.head_tiled
         out.reshape(nb, -1)[:, r.neck] = rigid.rotate_weighted(
             neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
+
+
+def _jaw_drop(operator: sp.csr_array, point: int, mns: float) -> float:
+    """How far the skin operator lowers vertex ``point`` per unit of FAP 3 (``MNS`` when
+    nothing in the operator moves it, so the teeth still open with the FAP)."""
+    dy = -float(operator[:, [point * 3 + 1]].toarray()[2, 0])
+    return dy if dy > 0 else mns
 
 
 def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.ndarray:

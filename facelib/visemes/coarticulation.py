@@ -16,6 +16,7 @@ from facelib.mpeg4.tables import N_FAPS, fap
 from facelib.visemes.tables import (
     coarticulation_classes,
     dominance_table,
+    lower_lip_per_jaw,
     timing_rules,
     viseme_targets,
 )
@@ -79,7 +80,8 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
 def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.ndarray) -> None:
     """Make the lips meet on every p/b/m, whatever the jaw does (speakers close the lips
     with the jaw part open): inside the span the lip heights are the closure's, and the
-    lower lip rises by the jaw's extra opening (the jaw carries the lower lip; both in MNS).
+    lower lip rises by the jaw's extra opening (the jaw carries the lower lip,
+    ``lower_lip_per_jaw`` MNS per jaw unit).
     The correction fades outside the span with the bilabial's own dominance fall-off, so
     the lips close smoothly; the frame nearest a span shorter than a frame is closed too."""
     classes = coarticulation_classes()
@@ -98,7 +100,7 @@ def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.n
             centre = 0.5 * (span.start_ms + span.end_ms)
             c[int(np.argmin(np.abs(times - centre)))] = 1.0
         out[:, lip] += c[:, None] * (targets[_BILABIAL, lip][None, :] - out[:, lip])
-        extra = np.maximum(out[:, jaw] - targets[_BILABIAL, jaw], 0.0)
+        extra = lower_lip_per_jaw() * np.maximum(out[:, jaw] - targets[_BILABIAL, jaw], 0.0)
         out[:, lower] += (c * extra)[:, None]
 
 

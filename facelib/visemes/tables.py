@@ -38,6 +38,7 @@ __all__ = [
     "PhoneViseme",
     "coarticulation_classes",
     "dominance_table",
+    "lower_lip_per_jaw",
     "phone_viseme",
     "script_name",
     "timing_rules",
@@ -176,6 +177,12 @@ def dominance_table() -> Mapping[tuple[int, str], Dominance]:
                 raise FacelibError(f"non-positive dominance for {name}/{cls}", path=data["_path"])
             out[vid, cls] = dom
     return MappingProxyType(out)
+
+
+@cache
+def lower_lip_per_jaw() -> float:
+    """MNS of lower-lip drop per unit of open_jaw (``lower_lip_per_jaw`` of the data file)."""
+    return float(_coarticulation().get("lower_lip_per_jaw", 1.0))
 
 
 @cache
