@@ -707,6 +707,7 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
         regions.append(
             {
                 "name": name,
+                "group": "lips",
                 "deformer": "rbf",
                 "feature_points": fps,
                 "vertices": members.tolist(),
@@ -730,6 +731,7 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
         regions.append(
             {
                 "name": f"brow_{side}",
+                "group": "brows",
                 "deformer": "rbf",
                 "feature_points": ids,
                 "vertices": inner.tolist(),
@@ -833,8 +835,8 @@ def learned_fields(pos, fp, *, skin_target, n_skin):
         key = f"field_{info.name}"
         arrays[key] = field[members].astype(np.float32)
         regions.append({"name": key, "deformer": "field",
-                        "feature_points": [info.feature_points[0]], "fap": info.name,
-                        "field": key, "targets": row["targets"],
+                        "feature_points": [info.feature_points[0]],
+                        "params": {"fap": info.name}, "field": key, "targets": row["targets"],
                         "note": row["note"], "vertices": members.tolist()})
     return regions, arrays
 

@@ -117,8 +117,8 @@ def main() -> None:
         fitted += [{"expression": name, "fap": k, "value": str(v), "note": note}
                    for k, v in values.items()]
         # FAPs the fit does not cover (head rotations) keep their rows
-        fitted += [r for r in rows if r["expression"] == name
-                   and r["fap"] not in FITTED and r["fap"] not in LIDS]
+        fitted += [r for r in rows
+                   if r["expression"] == name and fap(r["fap"]).kind == "rotation"]
     if args.dry_run:
         return
     kept = [r for r in rows if r["expression"] not in names]

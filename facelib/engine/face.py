@@ -24,14 +24,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from facelib.engine import rigid
-from facelib.engine.deformers import explicit_weights, raised_cosine_weights, rbf_weights
 from facelib.engine.fapu import compute_fapu
-from facelib.engine.fields import field_weights
+from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
 from facelib.errors import FaceModelError, ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
@@ -39,15 +39,15 @@ from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 __all__ = ["PART_NAMES", "Face", "Part", "Region"]
 
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
-LINEAR_DEFORMERS = ("cosine", "rbf", "weights")
-DEFORMERS = (*LINEAR_DEFORMERS, "field", "eyelid")
+RIGID_DEFORMERS = ("eyelid",)
+"""Deformers that are per-frame rigid steps of the face, not entries of the registry."""
 _EYELID_FAPS = {"3.1": 19, "3.2": 20, "3.3": 21, "3.4": 22}
 _EYES = (("eye_l", 23, 25, 27), ("eye_r", 24, 26, 28))
 _BLOCK = 32  # frames deformed together
 
 
 def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
-    out = np.array(array, dtype=dtype, copy=True)
+    out: np.ndarray = np.array(array, dtype=dtype, copy=True)
     out.flags.writeable = False
     return out
 
@@ -71,17 +71,18 @@ class Region:
     """An influence region of the face definition.
 
     name: unique name.
-    deformer: ``"cosine"`` (eq. 4.7), ``"rbf"`` (eq. 4.8-4.10), ``"weights"`` (explicit
-        per-vertex weights of one feature point), ``"field"`` (a learned displacement
-        field that alone drives one FAP, see :mod:`facelib.engine.fields`) or ``"eyelid"``
-        (rotation over the eye).
+    deformer: a name of :mod:`facelib.engine.registry` (``raised_cosine``, ``rbf``,
+        ``weights``, ...) or ``"eyelid"`` (rotation over the eye).
     feature_points: ids of the controlling feature points.
     vertices: (Vr,) int32 member vertices (the ones that move).
     anchors: (A,) int32 static border vertices (RBF only; empty otherwise).
     weights: (Vr,) float32 (``weights`` and ``eyelid`` only; empty otherwise).
     pivot: pivot name (``eyelid`` only).
-    fap: the FAP name a ``field`` region drives ("" otherwise).
-    displacements: (Vr, 3) float32 target displacements of the members (``field`` only).
+    params: the deformer's parameters as the definition (or an override) gives them.
+    group: an optional group name (``"lips"``) that overrides may use instead of the name.
+    custom: a :class:`~facelib.engine.registry.Deformer` given directly instead of a name.
+    displacements: (Vr, 3) float32 learned target displacements of the members (``field``
+        regions, which name their FAP in ``params["fap"]``; empty otherwise).
     """
 
     name: str
@@ -91,8 +92,20 @@ class Region:
     anchors: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
     weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
     pivot: str = ""
-    fap: str = ""
+    params: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    group: str = ""
+    custom: Deformer | None = None
     displacements: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+
+    @property
+    def field_fap(self) -> str:
+        """The FAP a ``field`` region drives alone ("" for other regions)."""
+        return str(self.params.get("fap", "")) if self.deformer == "field" else ""
+
+    @property
+    def algorithm(self) -> Deformer:
+        """The registered (or custom) deformer of this region; not for ``eyelid``."""
+        return self.custom if self.custom is not None else deformer(self.deformer)
 
 
 def _columns(ids: np.ndarray, axes: str = "xyz") -> np.ndarray:
@@ -179,6 +192,7 @@ class Face:
     _columns: np.ndarray = field(repr=False)
     _dense: np.ndarray = field(repr=False)
     _rigid: _Rigid = field(repr=False)
+    _steps: tuple[_Step, ...] = field(repr=False, default=())
 
     @classmethod
     def build(
@@ -209,7 +223,7 @@ class Face:
             inside[ids] = True
             part_map[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
-        operator = _compile(verts, tris, fps, fapu, regions)
+        operator, steps = _compile(verts, tris, fps, fapu, regions)
         for region in regions:
             for eye in ("eye_l", "eye_r"):
                 if np.isin(region.vertices, part_map[eye].vertex_ids).any():
@@ -259,6 +273,7 @@ class Face:
             _columns=columns,
             _dense=dense,
             _rigid=rigid_parts,
+            _steps=steps,
         )
 
     @property
@@ -267,11 +282,11 @@ class Face:
 
     @property
     def fap_deformers(self) -> Mapping[str, str]:
-        """FAP name -> the deformer kind that moves its feature point's surroundings:
-        ``"field"`` where a learned field drives the FAP, else the kinds of the regions
-        its feature point controls (joined by ``+``); FAPs that move no region are left out."""
+        """FAP name -> the deformer that moves its feature point's surroundings: ``"field"``
+        where a learned field drives the FAP alone, else the deformers of the regions its
+        feature point controls (joined by ``+``); FAPs that move no region are left out."""
         out: dict[str, str] = {}
-        fields = {r.fap: r.deformer for r in self.regions if r.deformer == "field"}
+        fields = {r.field_fap for r in self.regions if r.field_fap}
         for f in fap_table():
             if f.name in fields:
                 out[f.name] = "field"
@@ -313,6 +328,8 @@ class Face:
             if active.size:
                 flat[:, self._columns] += fb[:, active] @ self._dense[active]
             f64 = fb.astype(np.float64)
+            for step in self._steps:
+                step.apply(flat, f64)
             self._move_lids(pos, f64)
             self._move_eyes(pos, f64)
             self._move_jaw(pos, f64)
@@ -376,6 +393,42 @@ class Face:
             neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
 
 
+def _fp_motion(fapu: Mapping[str, float]) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """Per feature point: (FAP column, displacement per FAP unit (3,)) of every translational
+    FAP that moves it through the operator (eq. 4.6)."""
+    out: dict[str, list[tuple[int, np.ndarray]]] = {}
+    for f in fap_table():
+        if f.kind != "translation" or f.fapu not in fapu or f.id in _EYELID_FAPS.values():
+            continue
+        if f.id in (27, 28):  # eyeball thrust moves the whole eye (rigid step)
+            continue
+        scale = fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
+        out.setdefault(f.feature_points[0], []).append((f.index, scale))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class _Step:
+    """A non-linear region, corrected per frame: members += exact(dC) - linear(dC).
+
+    columns: (3Vr,) int64 columns of the members; motion: (84, 3N) float64 control
+    displacement per FAP unit; linear: (3N, 3Vr) float64 the region's operator block.
+    """
+
+    columns: np.ndarray
+    motion: np.ndarray
+    linear: np.ndarray
+    step: FrameStep
+
+    def apply(self, flat: np.ndarray, f: np.ndarray) -> None:
+        dc = f @ self.motion
+        if not dc.any():
+            return
+        n = len(f)
+        exact = self.step.displace(dc.reshape(n, -1, 3)).reshape(n, -1)
+        flat[:, self.columns] += (exact - dc @ self.linear).astype(np.float32)
+
+
 def _jaw_drop(operator: sp.csr_array, point: int, mns: float) -> float:
     """How far the skin operator lowers vertex ``point`` per unit of FAP 3 (``MNS`` when
     nothing in the operator moves it, so the teeth still open with the FAP)."""
@@ -383,78 +436,72 @@ def _jaw_drop(operator: sp.csr_array, point: int, mns: float) -> float:
     return dy if dy > 0 else mns
 
 
-def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.ndarray:
-    """Ids of the members that share a triangle with a vertex outside ``members``."""
-    inside = np.zeros(n_vertices, bool)
-    inside[members] = True
-    mixed = triangles[inside[triangles].any(1) & ~inside[triangles].all(1)]
-    return np.unique(mixed[inside[mixed]])
+def _region_weights(
+    region: Region, pos: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int]
+) -> tuple[np.ndarray, FrameStep | None]:
+    """``(Vr, 3, N, 3)`` weights of one region and its exact step (None when linear)."""
+    algo = region.algorithm
+    setup = RegionSetup(
+        name=region.name, members=region.vertices.astype(np.int64),
+        controls=np.array([fps[f] for f in region.feature_points], np.int64),
+        anchors=region.anchors.astype(np.int64), vertices=pos, triangles=triangles,
+        weights=region.weights.astype(np.float64),
+        params=MappingProxyType(algo.resolve(region.params, region=region.name)),
+        displacements=region.displacements.astype(np.float64))
+    w = np.asarray(algo.weights(setup), dtype=np.float64)
+    vr, n = setup.members.size, setup.controls.size
+    if w.shape == (vr, n):
+        w = w[:, None, :, None] * np.eye(3)[None, :, None, :]
+    elif w.shape != (vr, 3, n, 3):
+        raise FaceModelError(f"region {region.name!r}: deformer {algo.name!r} returned "
+                             f"weights of shape {w.shape}, not ({vr}, {n}) or ({vr}, 3, {n}, 3)")
+    exact = setup.params.get("mode") == "exact" and algo.step is not None
+    return w, (algo.step(setup) if exact and algo.step is not None else None)
 
 
 def _compile(
     verts: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int],
     fapu: Mapping[str, float], regions: tuple[Region, ...],
-) -> sp.csr_array:
-    """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP."""
+) -> tuple[sp.csr_array, tuple[_Step, ...]]:
+    """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP,
+    and the per-frame steps of non-linear regions."""
     nv = len(verts)
     pos = verts.astype(np.float64)
-    # per feature point: list of (member ids, weights) from every linear region it controls
-    carried: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
-    for region in regions:
-        if region.deformer not in LINEAR_DEFORMERS:
-            continue
-        members = region.vertices.astype(np.int64)
-        controls = pos[[fps[f] for f in region.feature_points]]
-        if region.deformer == "cosine":
-            edge = pos[_edge(members, triangles, nv)]
-            w = raised_cosine_weights(pos[members], controls, edge=edge)
-        elif region.deformer == "rbf":
-            w = rbf_weights(pos[members], controls, pos[region.anchors])
-        else:
-            w = explicit_weights(region.weights)
-        for k, fp_id in enumerate(region.feature_points):
-            keep = w[:, k] != 0
-            carried.setdefault(fp_id, []).append((members[keep], w[keep, k]))
-    fields = {fap(r.fap).index: r for r in regions if r.deformer == "field"}
+    tris = triangles.astype(np.int64)
+    motion = _fp_motion(fapu)
+    # a FAP that a learned field drives moves that field's region and no other
+    owned = {fap(r.field_fap).index for r in regions if r.field_fap}
     rows, cols, vals = [], [], []
-    for f in fap_table():
-        if f.kind != "translation" or f.fapu not in fapu or f.id in _EYELID_FAPS.values():
+    steps = []
+    for region in regions:
+        if region.deformer in RIGID_DEFORMERS:
             continue
-        if f.id in (27, 28):  # eyeball thrust moves the whole eye (rigid step)
-            continue
-        fp_id = f.feature_points[0]
-        direction = np.asarray(f.direction, dtype=np.float64)
-        if f.index in fields:  # a learned field replaces the regions for this FAP
-            region = fields[f.index]
-            members = region.vertices.astype(np.int64)
-            at = np.flatnonzero(members == fps[fp_id])
-            if at.size != 1:
-                raise FaceModelError(f"field region {region.name!r} must contain its feature "
-                                     f"point {fp_id} (vertex {fps[fp_id]})")
-            w3 = field_weights(region.displacements, int(at[0]), direction, fapu[f.fapu],
-                               name=region.name)
-            for axis in range(3):
-                rows.append(np.full(members.size, f.index))
-                cols.append(members * 3 + axis)
-                vals.append(w3[:, axis])
-            continue
-        scale = fapu[f.fapu] * direction
-        for members, w in carried.get(fp_id, ()):
-            for axis in range(3):
-                if scale[axis] == 0:
-                    continue
-                rows.append(np.full(members.size, f.index))
-                cols.append(members * 3 + axis)
-                vals.append(w * scale[axis])
+        w, step = _region_weights(region, pos, tris, fps)
+        members = region.vertices.astype(np.int64)
+        mine = {fap(region.field_fap).index} if region.field_fap else None
+        # g: (84, N, 3) control displacement per FAP unit
+        g = np.zeros((N_FAPS, len(region.feature_points), 3))
+        for k, fp_id in enumerate(region.feature_points):
+            for index, scale in motion.get(fp_id, ()):
+                if (index in mine) if mine is not None else (index not in owned):
+                    g[index, k] += scale
+        block = np.einsum("vaib,fib->fva", w, g)  # (84, Vr, 3)
+        fi, vi, ai = np.nonzero(block)
+        rows.append(fi)
+        cols.append(members[vi] * 3 + ai)
+        vals.append(block[fi, vi, ai])
+        if step is not None:
+            steps.append(_Step(_columns(members), g.reshape(N_FAPS, -1),
+                               w.reshape(members.size * 3, -1).T.copy(), step))
     if not rows:
-        return sp.csr_array((N_FAPS, nv * 3), dtype=np.float32)
+        return sp.csr_array((N_FAPS, nv * 3), dtype=np.float32), ()
     coo = sp.coo_array(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
         shape=(N_FAPS, nv * 3),
     )
     out = coo.tocsr().astype(np.float32)
     out.sum_duplicates()
-    return out
+    return out, tuple(steps)
 
 
 def _lids(

@@ -28,7 +28,7 @@ def test_default_head_records_which_deformer_drives_each_fap():
     assert kinds["lift_r_cheek"] == "field"
     assert kinds["lower_t_midlip"] == "rbf"  # lip heights stay with the RBF of the lips
     assert kinds["close_t_l_eyelid"] == "eyelid"
-    field_faps = {r.fap for r in face.regions if r.deformer == "field"}
+    field_faps = {r.field_fap for r in face.regions if r.deformer == "field"}
     assert field_faps == {k for k, v in kinds.items() if v == "field"}
 
 
@@ -57,9 +57,9 @@ def test_a_field_region_must_contain_its_feature_point(tmp_path):
     shutil.copy(src.parent / "default_head.npz", tmp_path / "default_head.npz")
     doc = json.loads(src.read_text())
     for region in doc["regions"]:
-        if region["deformer"] == "field":
-            region["fap"] = "open_jaw"  # a FAP on another feature point
+        if region["deformer"] == "field" and region["params"]["fap"] != "depress_chin":
+            region["params"]["fap"] = "depress_chin"  # a FAP on another feature point
             break
     (tmp_path / "head.json").write_text(json.dumps(doc))
-    with pytest.raises(FaceModelError, match="field FAP open_jaw moves"):
+    with pytest.raises(FaceModelError, match="field FAP depress_chin moves"):
         engine.load_face(tmp_path / "head.json")
