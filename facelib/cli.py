@@ -84,6 +84,7 @@ def _render(args: argparse.Namespace) -> int:
     if args.fap is not None:
         _write_fap(source if isinstance(source, FapStream) else source.faps, args.fap, "standard")
     out = render(source, face=load_face(args.face), out=args.output, width=args.width,
+                 framing=args.framing,
                  height=args.height, audio=args.audio, fps=args.fps)
     print(f"wrote {out} in {time.perf_counter() - started:.1f} s")
     return 0
@@ -219,6 +220,8 @@ def _add_render_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)
     command.add_argument("--fps", type=float, help="resample to this frame rate")
+    command.add_argument("--framing", choices=("face", "head", "bust"), default="face",
+                         help="what the camera frames (default: face, brow to chin)")
 
 
 def _build_parser() -> argparse.ArgumentParser:

@@ -92,6 +92,7 @@ def render(
     background: Sequence[float] | None = None,
     progress: bool = True,
     fps: float | None = None,
+    framing: str | np.ndarray = "face",
 ) -> np.ndarray | Path:
     """Render an animation of ``face`` driven by ``source``.
 
@@ -110,6 +111,8 @@ def render(
     background: sRGB colour in [0, 1] behind the face; None uses the look's.
     progress: show a progress bar when stderr is a terminal.
     fps: resample the stream to this frame rate first (None keeps the stream's).
+    framing: ``"face"`` (brow to chin over half the frame height), ``"head"``, ``"bust"``,
+        or ``(N, 3)`` points to frame (see :class:`~facelib.rendering.scene.FaceRenderer`).
 
     Returns
     -------
@@ -129,10 +132,11 @@ def render(
                 "give a folder to write one PNG per frame"
             )
         return save_png(render_still(face, stream.values[0], width=width, height=height,
-                                     background=background), out)
+                                     background=background, framing=framing), out)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
-    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+    with FaceRenderer(face, width=width, height=height, background=background,
+                      framing=framing) as renderer:
         frames = iter_frames(renderer, face, stream, progress=progress)
         if out is None:
             result = np.empty((stream.n_frames, renderer.height, renderer.width, 3), np.uint8)
@@ -160,8 +164,9 @@ def render_still(
     width: int = 640,
     height: int = 480,
     background: Sequence[float] | None = None,
+    framing: str | np.ndarray = "face",
 ) -> np.ndarray:
-    """One ``(height, width, 3) uint8`` image of ``face``.
+    """One ``(height, width, 3) uint8`` image of ``face`` (``framing`` as in :func:`render`).
 
     ``pose`` is an ``(84,)`` FAP vector (deformed with ``face.deform_frame``), a ``(V, 3)``
     vertex array, or None for the neutral face. For many stills of one face, keep a
@@ -180,5 +185,6 @@ def render_still(
             raise ParameterError(
                 f"pose must be ({N_FAPS},) FAP values or (V, 3) vertices, got {pose.shape}"
             )
-    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+    with FaceRenderer(face, width=width, height=height, background=background,
+                      framing=framing) as renderer:
         return renderer.frame(vertices)

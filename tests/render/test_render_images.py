@@ -22,7 +22,7 @@ def faps(**values: float) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def renderer(synthetic_face):
-    with FaceRenderer(synthetic_face, width=W, height=H) as r:
+    with FaceRenderer(synthetic_face, width=W, height=H, framing="head") as r:
         yield r
 
 
