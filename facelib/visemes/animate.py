@@ -15,6 +15,7 @@ from facelib.mpeg4.track import FapTrack
 from facelib.speech import align as align_phones
 from facelib.speech import timeline_from_text as phones_from_text
 from facelib.speech.align import OnImplausible
+from facelib.speech.audio import load_speech
 from facelib.visemes.coarticulation import (
     blend,
     driven_faps,
@@ -22,9 +23,10 @@ from facelib.visemes.coarticulation import (
     frame_times_ms,
     speaking_mask,
 )
+from facelib.visemes.loudness import jaw_gain
 from facelib.visemes.mapping import with_visemes
 from facelib.visemes.scripts import visemes_from_cues
-from facelib.visemes.tables import timing_rules
+from facelib.visemes.tables import loudness_rules, timing_rules
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
 __all__ = ["VisemeAnimation", "align", "animate", "speech_timeline", "timeline_from_text"]
@@ -101,6 +103,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     envelope, which is also the weight on the driven FAPs (0 elsewhere): weights and
     values fade together, so where the viseme track alone drives a FAP it eases out
     instead of dropping to 0 in one frame.
+    With audio, louder speech opens the jaw further (:mod:`facelib.visemes.loudness`).
     ``rate`` is the speaking rate of the text-only duration model. Speech longer than
     ``max_frames`` raises SpeechError before the curves are computed.
     """
@@ -115,7 +118,11 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
                           f"than max_frames={max_frames}", path=path, line=line)
     times = frame_times_ms(n_frames, fps)
     env = envelope(timeline.visemes, times)
-    values = blend(timeline.visemes, times) * env[:, None]
+    gain = None
+    if speech.audio is not None and not speech.visemes:
+        gain = jaw_gain(load_speech(speech.audio), times, start_ms=speech.start_ms,
+                        rules=loudness_rules())
+    values = blend(timeline.visemes, times, jaw_gain=gain) * env[:, None]
     weight = np.zeros_like(values)
     weight[:, driven_faps()] = env[:, None]
     speaking = speaking_mask(timeline.visemes, times)

@@ -42,14 +42,17 @@ def driven_faps() -> np.ndarray:
     return mask
 
 
-def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
+def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray, *,
+          jaw_gain: np.ndarray | None = None) -> np.ndarray:
     """FAP values ``(len(times_ms), 84) float32`` (FAP units) of the viseme sequence.
 
     For each FAP class k (jaw, lip height, lip shape, tongue) and span s the dominance is
     ``alpha_sk * exp(-theta_sk * d)``, d the distance in seconds from the time to the span
     (0 inside it; ``theta_before`` before it, ``theta_after`` after it). Each FAP is the
     dominance-weighted mean of the spans' targets. The lips then close on every p/b/m
-    (see ``_close_bilabials``). FAPs outside the classes stay 0.
+    (see ``_close_bilabials``). FAPs outside the classes stay 0. ``jaw_gain``
+    (``(len(times_ms),)``, e.g. from the speech's loudness) scales the jaw opening before
+    the bilabial closure, so p/b/m still close.
     """
     times = np.asarray(times_ms, dtype=np.float64)
     out = np.zeros((times.size, N_FAPS), np.float32)
@@ -73,6 +76,8 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
         dom = np.exp(log_dom)
         cols = list(columns)
         out[:, cols] = (dom @ targets[:, cols]) / dom.sum(axis=1, keepdims=True)
+    if jaw_gain is not None:
+        out[:, fap("open_jaw").index] *= np.asarray(jaw_gain, np.float32)
     _close_bilabials(out, visemes, times)
     return out
 

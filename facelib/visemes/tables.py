@@ -35,6 +35,7 @@ __all__ = [
     "PhoneViseme",
     "coarticulation_classes",
     "dominance_table",
+    "loudness_rules",
     "lower_lip_per_jaw",
     "phone_viseme",
     "script_name",
@@ -163,6 +164,13 @@ def dominance_table() -> Mapping[tuple[int, str], Dominance]:
                 raise DataError(f"non-positive dominance for {name}/{cls}", path=path)
             out[vid, cls] = dom
     return MappingProxyType(out)
+
+
+@cache
+def loudness_rules() -> Mapping[str, float]:
+    """The ``loudness`` rules of the data file (see :mod:`facelib.visemes.loudness`)."""
+    raw = _coarticulation()["loudness"]
+    return MappingProxyType({k: float(v) for k, v in raw.items() if not k.startswith("_")})
 
 
 @cache
