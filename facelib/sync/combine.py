@@ -6,7 +6,8 @@ Each step is a small pure function over :class:`FapTrack` objects:
 2. :func:`blend` the result with gaze (eyelid and head conflict, 25 % gaze);
 3. :func:`close_lids` for blinks, which no expression may hold open;
 4. :func:`add_head_noise` where gaze does not move the head;
-5. :func:`to_stream`.
+5. nods on the stressed syllables (:mod:`facelib.sync.nods`), likewise;
+6. :func:`to_stream`.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import ANGLE_UNIT, fap
 from facelib.mpeg4.track import FapTrack
+from facelib.sync.nods import accents, add_nods
 from facelib.sync.noise import perlin1d
 from facelib.sync.rules import HeadNoise, SyncRules
 
@@ -133,8 +135,11 @@ def combine(
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
     if blinks is not None:
         face = close_lids(face, blinks, closed=blink_lids)
+    head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
     if rules.head_noise is not None:
-        head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
         face = add_head_noise(face, noise=rules.head_noise, seed=seed,
                               head_driven=head_driven, speaking=speaking)
+    if rules.speech_nods is not None:
+        face = add_nods(face, strength=accents(visemes, nods=rules.speech_nods),
+                        nods=rules.speech_nods, seed=seed, head_driven=head_driven)
     return to_stream(face)

@@ -14,6 +14,7 @@ import numpy as np
 
 from facelib.errors import ParameterError
 from facelib.mpeg4.tables import N_FAPS, fap
+from facelib.sync.nods import Nods
 
 __all__ = ["HeadNoise", "SyncRules"]
 
@@ -40,6 +41,7 @@ class SyncRules:
     eyes_head: (expression, gaze) weights on eyelids and head; (0.75, 0.25) in the thesis.
     expression_importance, viseme_importance: name -> factor in [0, 1] on that side's weight.
     head_noise: idle head motion, or None for none.
+    speech_nods: nods on stressed syllables while speaking, or None for none.
     """
 
     mouth: tuple[float, float] = (1.0, 3.0)
@@ -48,6 +50,7 @@ class SyncRules:
     expression_importance: Mapping[str, float] = field(default_factory=dict)
     viseme_importance: Mapping[str, float] = field(default_factory=dict)
     head_noise: HeadNoise | None = HeadNoise()
+    speech_nods: Nods | None = field(default_factory=Nods)
 
     def mouth_weights(self) -> tuple[np.ndarray, np.ndarray]:
         """Per-FAP (expression, viseme) weights of the mouth blend: two ``(84,) float64``
@@ -68,6 +71,7 @@ class SyncRules:
         try:
             data: dict[str, Any] = json.loads(text)
             noise = data.get("head_noise")
+            nods = data.get("speech_nods")
             rules = cls(
                 mouth=(float(data["mouth"]["expression"]), float(data["mouth"]["viseme"])),
                 mouth_faps=MappingProxyType(_mouth_faps(data.get("mouth_faps", []))),
@@ -87,6 +91,8 @@ class SyncRules:
                     speaking_amplitude=float(noise["speaking_amplitude"]),
                     speaking_frequency=float(noise["speaking_frequency"]),
                 ),
+                speech_nods=None if nods is None else Nods(
+                    **{k: float(nods[k]) for k in Nods.__dataclass_fields__}),
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise ParameterError(f"bad synchronizer rules: {exc!r}", path=where) from exc

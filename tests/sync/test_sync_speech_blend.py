@@ -92,3 +92,33 @@ def test_per_fap_blend_is_eq_4_11_where_the_table_says_1_3():
     out = blend(e, v, weight_a=we, weight_b=wv)
     assert out.values[0, JAW] == pytest.approx((100 + 3 * 300) / 4)
     assert out.values[0, CORNERS[0]] == pytest.approx((4 * 100 + 300) / 5)
+
+
+def test_speech_nods_on_stressed_syllables_are_seeded_and_sized(hello):
+    """Issue 14 item 8: nods of 2-5 degrees on the jaw-opening peaks while speaking."""
+    import dataclasses
+
+    from facelib import animate
+    from facelib.mpeg4.tables import ANGLE_UNIT
+    from facelib.sync.nods import Nods, accents
+
+    rules = SyncRules.load()
+    assert rules.speech_nods is not None
+    still = animate(hello.storyboard, rules=dataclasses.replace(rules, speech_nods=None))
+    again = animate(hello.storyboard)
+    assert again.faps == hello.faps  # deterministic
+    pitch = fap("head_pitch").index
+    nod = np.rad2deg((hello.faps.values[:, pitch] - still.faps.values[:, pitch]) * ANGLE_UNIT)
+    assert 2.0 <= nod.max() <= 5.0
+    strength = accents(hello.tracks["visemes"], nods=Nods())
+    beats = np.flatnonzero(strength)
+    assert len(beats) >= 4
+    # every accent has its nod around it (unless gaze turns the head then), and the nods lie
+    # around accents
+    gaze_head = hello.tracks["gaze"].weight[:, pitch]
+    for i in beats[gaze_head[beats] == 0]:
+        assert nod[max(i - 3, 0): i + 4].max() > 0.5 * strength[i] * Nods().pitch_deg
+    quiet = np.ones(nod.size, bool)
+    for i in beats:
+        quiet[max(i - 6, 0): i + 7] = False
+    assert np.abs(nod[quiet]).max() < 0.05
