@@ -15,7 +15,8 @@ Deformation of one frame ``f`` (84 FAP values):
    chin's drop of ``f_3 * MNS``) plus the thrust (FAP 14) and shift (FAP 15) translations;
 5. the head rotates about its pivot (FAP 48-50), fading to nothing over the neck.
 
-FAPs 1-2 (high-level visemes and expressions, expanded by the generators), 29-30 (pupil
+FAPs 1-2 (high-level visemes and expressions) are decoded into low-level FAPs by ``deform``
+(:mod:`facelib.mpeg4.highlevel`); 29-30 (pupil
 dilation) and 47 (tongue roll) do not move this mesh.
 """
 
@@ -33,6 +34,7 @@ from facelib.engine import rigid
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
 from facelib.errors import FaceModelError, ParameterError
+from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 
@@ -176,6 +178,8 @@ class Face:
         radians (eq. 4.1-4.5).
     regions: the influence regions.
     pivots: ``eye_l``, ``eye_r``, ``head``, ``jaw`` -> (3,) float64 positions.
+    neck: ``(point (3,), unit normal (3,) into the head, blend distance)`` of the plane
+        where head rotations fade out.
     operator: scipy CSR array (84, 3V) float32: vertex displacements (flattened ``(V, 3)``)
         per FAP unit, for every translational FAP that deforms linearly.
     """
@@ -188,6 +192,7 @@ class Face:
     fapu: Mapping[str, float]
     regions: tuple[Region, ...]
     pivots: Mapping[str, np.ndarray]
+    neck: tuple[np.ndarray, np.ndarray, float]
     operator: sp.csr_array = field(repr=False)
     _columns: np.ndarray = field(repr=False)
     _dense: np.ndarray = field(repr=False)
@@ -216,12 +221,7 @@ class Face:
         tris = _readonly(triangles, np.int32)
         fps = MappingProxyType(dict(feature_points))
         fapu = MappingProxyType(compute_fapu(verts, fps))
-        part_map = {}
-        for name, part_ids in parts.items():
-            ids = _readonly(part_ids, np.int32)
-            inside = np.zeros(len(verts), bool)
-            inside[ids] = True
-            part_map[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+        part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
         operator, steps = _compile(verts, tris, fps, fapu, regions)
         for region in regions:
@@ -233,33 +233,8 @@ class Face:
                     )
         columns = np.unique(operator.indices).astype(np.int64)
         dense = operator[:, columns].toarray().astype(np.float32)
-        head = pivot_map["head"]
-        point, normal, blend = neck
-        height = (verts.astype(np.float64) - point) @ normal
-        t = np.clip(height / blend, 0.0, 1.0)
-        head_w = t * t * (3 - 2 * t)
-        jaw_ids = np.concatenate(
-            [part_map["teeth_lower"].vertex_ids, part_map["tongue"].vertex_ids])
-        rigid_parts = _Rigid(
-            lids=_lids(verts, fps, fapu, regions, pivot_map),
-            eyes=tuple(
-                (_columns(part_map[name].vertex_ids),
-                 (verts[part_map[name].vertex_ids] - pivot_map[name]).astype(np.float32),
-                 np.tile(pivot_map[name].astype(np.float32), part_map[name].vertex_ids.size),
-                 yaw, pitch, thrust)
-                for name, yaw, pitch, thrust in _EYES
-            ),
-            jaw_x=_columns(jaw_ids, "x"),
-            jaw_y=_columns(jaw_ids, "y"),
-            jaw_z=_columns(jaw_ids, "z"),
-            jaw_pivot=pivot_map["jaw"],
-            chin=verts[fps["2.3"]].astype(np.float64),
-            chin_drop=_jaw_drop(operator, fps["2.3"], fapu["MNS"]),
-            head_pivot=head,
-            head_tiled=np.tile(head.astype(np.float32), len(verts)),
-            head_weights=head_w[head_w < 1.0].astype(np.float32),
-            neck=_columns(np.nonzero(head_w < 1.0)[0]),
-        )
+        rigid_parts = _rigid(verts, fps, fapu, regions=regions, parts=part_map,
+                             pivots=pivot_map, neck=neck, operator=operator)
         return cls(
             vertices=verts,
             triangles=tris,
@@ -269,12 +244,20 @@ class Face:
             fapu=fapu,
             regions=tuple(regions),
             pivots=MappingProxyType(pivot_map),
+            neck=(_readonly(neck[0], np.float64), _readonly(neck[1], np.float64),
+                  float(neck[2])),
             operator=operator,
             _columns=columns,
             _dense=dense,
             _rigid=rigid_parts,
             _steps=steps,
         )
+
+    def __repr__(self) -> str:
+        """One line: sizes and names, never the arrays."""
+        return (f"Face(vertices={len(self.vertices)}, triangles={len(self.triangles)}, "
+                f"parts=[{', '.join(self.parts)}], feature_points={len(self.feature_points)}, "
+                f"regions={len(self.regions)})")
 
     @property
     def n_vertices(self) -> int:
@@ -300,9 +283,14 @@ class Face:
         return MappingProxyType(out)
 
     def deform(self, stream: FapStream) -> np.ndarray:
-        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``."""
+        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``.
+
+        High-level FAPs 1 and 2 (viseme and expression selects and blends) are decoded
+        first (:func:`facelib.mpeg4.highlevel.apply_high_level`), as an MPEG-4 player does.
+        """
         if not isinstance(stream, FapStream):
             raise ParameterError(f"deform() takes a FapStream, not {type(stream).__name__}")
+        stream = apply_high_level(stream)  # FAP 1/2 from other tools' files
         return self._deform(np.asarray(stream.values, dtype=np.float32))
 
     def deform_frame(self, values: np.ndarray) -> np.ndarray:
@@ -537,3 +525,49 @@ def _lids(
     centres = np.array([pivots[name] for name in pivot_of], np.float32).reshape(-1, 3)
     return _Lids(tuple(hinges), _columns(ids, "y"), _columns(ids, "z"), centres[:, 1],
                  centres[:, 2], weights)
+
+
+def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
+           ) -> dict[str, Part]:
+    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it."""
+    out = {}
+    for name, part_ids in parts.items():
+        ids = _readonly(part_ids, np.int32)
+        inside = np.zeros(n_vertices, bool)
+        inside[ids] = True
+        out[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+    return out
+
+
+def _rigid(verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float], *,
+           regions: tuple[Region, ...], parts: Mapping[str, Part],
+           pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float],
+           operator: sp.csr_array) -> _Rigid:
+    """The rigid steps' precomputed columns, offsets and weights (eyes, lids, jaw, head)."""
+    head = pivots["head"]
+    point, normal, blend = neck
+    height = (verts.astype(np.float64) - point) @ normal
+    t = np.clip(height / blend, 0.0, 1.0)
+    head_w = t * t * (3 - 2 * t)
+    jaw_ids = np.concatenate(
+        [parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
+    return _Rigid(
+        lids=_lids(verts, fps, fapu, regions, pivots),
+        eyes=tuple(
+            (_columns(parts[name].vertex_ids),
+             (verts[parts[name].vertex_ids] - pivots[name]).astype(np.float32),
+             np.tile(pivots[name].astype(np.float32), parts[name].vertex_ids.size),
+             yaw, pitch, thrust)
+            for name, yaw, pitch, thrust in _EYES
+        ),
+        jaw_x=_columns(jaw_ids, "x"),
+        jaw_y=_columns(jaw_ids, "y"),
+        jaw_z=_columns(jaw_ids, "z"),
+        jaw_pivot=pivots["jaw"],
+        chin=verts[fps["2.3"]].astype(np.float64),
+        chin_drop=_jaw_drop(operator, fps["2.3"], fapu["MNS"]),
+        head_pivot=head,
+        head_tiled=np.tile(head.astype(np.float32), len(verts)),
+        head_weights=head_w[head_w < 1.0].astype(np.float32),
+        neck=_columns(np.nonzero(head_w < 1.0)[0]),
+    )

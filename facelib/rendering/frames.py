@@ -9,7 +9,6 @@ the headless platform chosen by :mod:`facelib.rendering.platform`.
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import numpy as np
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS
+from facelib.progress import ProgressCallback, progress_callback
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import open_writer, save_png
@@ -47,50 +47,50 @@ def stream_of(source: FapStream | HasFaps) -> tuple[FapStream, Path | None, floa
     )
 
 
-def face_or_default(face: Deformable | None) -> Deformable:
-    """``face``, or facelib's default head when it is None."""
-    if face is not None:
-        return face
-    from facelib.engine import default_face
+def face_or_default(face: Deformable | str | os.PathLike[str] | None,
+                    source: object = None) -> Deformable:
+    """``face``; a face definition JSON path loaded; None: the face the source's storyboard
+    names (``face = "..."``), else facelib's default head."""
+    from facelib.engine import default_face, load_face
 
-    return default_face()
+    if face is None:
+        storyboard = getattr(source, "storyboard", None)
+        face = getattr(storyboard, "face", None)
+    if isinstance(face, (str, os.PathLike)):
+        return load_face(Path(face))
+    return default_face() if face is None else face
 
 
 def iter_frames(
-    renderer: FaceRenderer, face: Deformable, stream: FapStream, *, progress: bool = False
+    renderer: FaceRenderer, face: Deformable, stream: FapStream, *,
+    progress: bool | ProgressCallback | None = False,
 ) -> Iterator[np.ndarray]:
-    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``."""
-    bar = None
-    if progress and sys.stderr.isatty():
-        try:
-            from tqdm import tqdm
-        except ImportError:
-            bar = None
-        else:
-            bar = tqdm(total=stream.n_frames, unit="frame", desc="rendering", leave=False)
-    try:
-        for start in range(0, stream.n_frames, _CHUNK):
-            vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
-            for frame_vertices in vertices:
-                yield renderer.frame(frame_vertices)
-                if bar is not None:
-                    bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
+    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``.
+
+    ``progress``: see :mod:`facelib.progress`; called with (frames done, n_frames).
+    """
+    report = progress_callback(progress, "rendering", unit="frames")
+    done = 0
+    for start in range(0, stream.n_frames, _CHUNK):
+        vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
+        for frame_vertices in vertices:
+            yield renderer.frame(frame_vertices)
+            done += 1
+            if report is not None:
+                report(done, stream.n_frames)
 
 
 def render(
     source: FapStream | HasFaps,
     *,
-    face: Deformable | None = None,
+    face: Deformable | str | os.PathLike[str] | None = None,
     out: str | os.PathLike[str] | None = None,
     width: int = 640,
     height: int = 480,
     audio: str | os.PathLike[str] | None = None,
     audio_offset: float | None = None,
     background: Sequence[float] | None = None,
-    progress: bool = True,
+    progress: bool | ProgressCallback | None = True,
     fps: float | None = None,
     framing: str | np.ndarray = "face",
 ) -> np.ndarray | Path:
@@ -101,7 +101,8 @@ def render(
     source: a :class:`FapStream`, or an animation with ``.faps`` (and optional ``.audio``,
         ``.audio_offset``).
     face: the face to deform (``Face``-like: ``vertices``, ``triangles``, ``vertex_colors``,
-        ``parts``, ``deform``); None loads the default head.
+        ``parts``, ``deform``) or a face definition JSON path; None takes the face the
+        storyboard names (``face = "..."``), else the default head.
     out: None returns the frames; a path writes them by suffix: ``.mp4`` (H.264, with the
         audio), ``.gif``, or a folder (no suffix) of ``frame_NNNNNN.png``; ``.png`` writes a
         single-frame source as one still.
@@ -109,7 +110,8 @@ def render(
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
     background: sRGB colour in [0, 1] behind the face; None uses the look's.
-    progress: show a progress bar when stderr is a terminal.
+    progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
+        None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
     fps: resample the stream to this frame rate first (None keeps the stream's).
     framing: ``"face"`` (brow to chin over half the frame height), ``"head"``, ``"bust"``,
         or ``(N, 3)`` points to frame (see :class:`~facelib.rendering.scene.FaceRenderer`).
@@ -124,15 +126,10 @@ def render(
         stream = stream.resample(fps)
     audio = source_audio if audio is None else Path(audio)
     offset = source_offset if audio_offset is None else float(audio_offset)
-    face = face_or_default(face)
+    face = face_or_default(face, source)
     if out is not None and Path(out).suffix.lower() == ".png":
-        if stream.n_frames != 1:
-            raise ParameterError(
-                f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
-                "give a folder to write one PNG per frame"
-            )
-        return save_png(render_still(face, stream.values[0], width=width, height=height,
-                                     background=background, framing=framing), out)
+        return _one_png(face, stream, out, width=width, height=height, background=background,
+                        framing=framing)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
     with FaceRenderer(face, width=width, height=height, background=background,
@@ -143,18 +140,40 @@ def render(
             for i, image in enumerate(frames):
                 result[i] = image
             return result
-        writer = open_writer(
-            out, fps=stream.fps, width=width, height=height,
-            audio=audio if Path(out).suffix.lower() == ".mp4" else None,
-            audio_offset=offset, duration=stream.duration,
+        mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
+        return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
+                      audio_offset=offset)
+
+
+def _one_png(
+    face: Deformable, stream: FapStream, out: str | os.PathLike[str], *, width: int,
+    height: int, background: Sequence[float] | None, framing: str | np.ndarray = "face",
+) -> Path:
+    """A single-frame stream rendered to the PNG ``out``."""
+    if stream.n_frames != 1:
+        raise ParameterError(
+            f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
+            "give a folder to write one PNG per frame"
         )
-        try:
-            for image in frames:
-                writer.write(image)
-        except BaseException:
-            writer.abort()
-            raise
-        return writer.commit()
+    return save_png(render_still(face, stream.values[0], width=width, height=height,
+                                 background=background, framing=framing), out)
+
+
+def _write(
+    frames: Iterator[np.ndarray], out: str | os.PathLike[str], stream: FapStream, *,
+    width: int, height: int, audio: Path | None, audio_offset: float,
+) -> Path:
+    """Write ``frames`` (each ``(height, width, 3) uint8``) to ``out`` at the stream's
+    frame rate; a failure removes what was written."""
+    writer = open_writer(out, fps=stream.fps, width=width, height=height, audio=audio,
+                         audio_offset=audio_offset, duration=stream.duration)
+    try:
+        for image in frames:
+            writer.write(image)
+    except BaseException:
+        writer.abort()
+        raise
+    return writer.commit()
 
 
 def render_still(

@@ -1,0 +1,137 @@
+"""The issue's pixel checks on the real default head (skipped while the engine is absent)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facelib.rendering.scene import FaceRenderer
+
+engine = pytest.importorskip("facelib.engine")
+W, H = 200, 200
+
+
+@pytest.fixture(scope="module")
+def head(default_face):
+    face = default_face
+    with FaceRenderer(face, width=W, height=H) as renderer:
+        yield face, renderer
+
+
+def test_jaw_open_moves_mouth_pixels_not_forehead(head, fap_frame):
+    face, renderer = head
+    neutral = renderer.frame(face.deform_frame(fap_frame()))
+    opened = renderer.frame(face.deform_frame(fap_frame(f3=600)))
+    diff = np.abs(neutral.astype(int) - opened.astype(int)).sum(axis=2)
+    chin_row = renderer.project(face.vertices[face.feature_points["2.1"]])[0, 1]
+    eye_row = renderer.project(face.pivots["eye_l"])[0, 1]
+    changed = np.flatnonzero(diff.max(axis=1) > 30)
+    assert changed.size > 3
+    assert changed.min() > eye_row  # forehead and eyes untouched
+    assert np.abs(changed - chin_row).min() < 10  # the change is around the mouth and chin
+
+
+def test_eyes_turned_left_move_the_iris_right_in_the_image(head, fap_frame):
+    face, renderer = head
+    centres = renderer.project(np.vstack([face.pivots["eye_l"], face.pivots["eye_r"]]))
+
+    def iris_x(image: np.ndarray) -> float:
+        xs = []
+        for cx, cy in centres:
+            r0, c0 = int(cy) - 6, int(cx) - 10
+            patch = image[r0 : r0 + 12, c0 : c0 + 20].astype(int).sum(axis=2)
+            dark = patch < np.percentile(patch, 15)
+            xs.append(np.nonzero(dark)[1].mean() + c0)
+        return float(np.mean(xs))
+
+    x0 = iris_x(renderer.frame(face.deform_frame(fap_frame())))
+    x_left = iris_x(renderer.frame(face.deform_frame(fap_frame(f23=40000, f24=40000))))
+    x_right = iris_x(renderer.frame(face.deform_frame(fap_frame(f23=-40000, f24=-40000))))
+    # FAP 23/24 positive turns the eyes to the face's own left, the image's right
+    assert x_left > x0 + 1.5
+    assert x_right < x0 - 1.5
+
+
+def test_open_mouth_close_up_shows_a_dark_cavity_not_the_background(fap_frame):
+    """Framing the mouth alone must not clip the cavity behind it (the far plane follows
+    the whole head), and the cavity is painted dark."""
+    face = engine.load_face(None)
+    fp = face.feature_points
+    mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "8.1", "2.1")]]
+    with FaceRenderer(face, width=W, height=H, framing=mouth) as renderer:
+        moved = face.deform_frame(fap_frame(f3=900))
+        image = renderer.frame(moved).astype(int)
+        background = np.asarray(renderer.look.background) * 255
+        # the opening: between the lip midpoints, inward of the corners
+        (_, uy), (_, ly) = renderer.project(moved[[fp["2.2"], fp["2.3"]]])
+        (cl, _), (cr, _) = renderer.project(moved[[fp["2.4"], fp["2.5"]]])
+    rows = slice(int(uy) + 2, int(ly) - 1)
+    cols = slice(int(min(cl, cr)) + 4, int(max(cl, cr)) - 3)
+    opening = image[rows, cols]
+    assert opening.shape[0] > 3
+    assert not np.any(np.abs(opening - background).sum(axis=2) < 12)
+    assert np.percentile(opening.sum(axis=2), 25) < 250  # a dark cavity shows
+
+
+def test_resting_and_bilabial_lips_hide_the_teeth():
+    """Closed lips meet: no tooth shows through a slit (teeth painted green to find them)."""
+    import dataclasses
+
+    from facelib.visemes import viseme_targets
+    from facelib.visemes.tables import viseme_id
+
+    face = engine.load_face(None)
+    colours = np.array(face.vertex_colors)
+    for part in ("teeth_upper", "teeth_lower"):
+        colours[face.parts[part].vertex_ids] = (0.0, 1.0, 0.0)
+    painted = dataclasses.replace(face, vertex_colors=colours)
+    fp = face.feature_points
+    mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "8.1", "2.1")]]
+    with FaceRenderer(painted, width=400, height=300, framing=mouth) as renderer:
+        for values in (np.zeros(84, np.float32), viseme_targets()[viseme_id("PP")],
+                       viseme_targets()[viseme_id("E")]):
+            image = renderer.frame(face.deform_frame(values)).astype(int)
+            teeth = ((image[..., 1] > image[..., 0] + 40)
+                     & (image[..., 1] > image[..., 2] + 40)).sum()
+            if values.any() and values[2] > 300:  # 'E' opens the mouth: the check sees teeth
+                assert teeth > 500
+            else:
+                assert teeth < 60
+
+
+def test_closed_lids_cover_the_whole_eye(fap_frame):
+    """A blink hides the sclera right into the corners (white pixels of a close-up)."""
+    face = engine.load_face(None)
+    fp = face.feature_points
+    lids = face.vertices[[fp[k] for k in ("3.1", "3.2", "3.3", "3.4")]]
+    side = np.array([0.012, 0.0, 0.0])
+    around = np.vstack([lids + side, lids - side])
+    closed = fap_frame(f19=1024, f20=1024)
+    with FaceRenderer(face, width=400, height=150, framing=around) as renderer:
+        white = []
+        for values in (fap_frame(), closed):
+            image = renderer.frame(face.deform_frame(values)).astype(int)
+            white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
+    assert white[0] > 500
+    assert white[1] < 0.03 * white[0]
+
+
+def test_named_framings_and_the_default_face_close_up():
+    """Issue 14: the default frames the face (brow to chin over half the frame height);
+    'head' and 'bust' step back; an unknown name is an error."""
+    from facelib.errors import ParameterError
+
+    face = engine.load_face(None)
+    fp = face.feature_points
+    spans = {}
+    for name in ("face", "head", "bust"):
+        with FaceRenderer(face, width=320, height=240, framing=name) as renderer:
+            (_, brow), (_, chin) = renderer.project(face.vertices[[fp["4.3"], fp["2.1"]]])
+            spans[name] = (chin - brow) / 240
+    with FaceRenderer(face, width=320, height=240) as renderer:
+        (_, brow), (_, chin) = renderer.project(face.vertices[[fp["4.3"], fp["2.1"]]])
+    assert (chin - brow) / 240 == pytest.approx(spans["face"])
+    assert spans["face"] >= 0.5
+    assert spans["face"] > spans["head"] > spans["bust"] > 0.15
+    with pytest.raises(ParameterError, match="framing must be one of"):
+        FaceRenderer(face, width=64, height=64, framing="shoulders")
