@@ -109,17 +109,14 @@ def render(
     width, height: image size in pixels (even for ``.mp4``).
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
-    background: sRGB colour in [0, 1] behind the face; None uses the look's.
+    background: sRGB colour in [0, 1] behind the face; None uses the look's. framing:
+        ``"face"``, ``"head"``, ``"bust"`` or points (see ``FaceRenderer``).
     progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
         None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
     fps: resample the stream to this frame rate first (None keeps the stream's).
-    framing: ``"face"`` (brow to chin over half the frame height), ``"head"``, ``"bust"``,
-        or ``(N, 3)`` points to frame (see :class:`~facelib.rendering.scene.FaceRenderer`).
 
-    Returns
-    -------
-    ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the written
-    path. The camera is framed once on the neutral face and stays put.
+    Returns ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the
+    written path. The camera is framed once on the neutral face and stays put.
     """
     stream, source_audio, source_offset = stream_of(source)
     if fps is not None:
