@@ -125,8 +125,7 @@ def render(
     width, height: image size in pixels (even for ``.mp4``).
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
-    background: sRGB colour in [0, 1] behind the face; None uses the look's. framing:
-        ``"face"``, ``"head"``, ``"bust"`` or points (see ``FaceRenderer``).
+    background: sRGB colour behind the face (None: the look's). framing: see FaceRenderer.
     progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
         None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
     fps: resample the stream to this frame rate first (None keeps the stream's).
