@@ -272,6 +272,8 @@ def _add_render_options(command: argparse.ArgumentParser, *, batch: bool) -> Non
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)
     command.add_argument("--fps", type=float, help="resample to this frame rate")
+    command.add_argument("--framing", choices=("face", "head", "bust"), default="face",
+                         help="what the camera frames (default: face, brow to chin)")
 
 
 def _add_render(commands: Any) -> None:
@@ -306,6 +308,7 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
         write_fap(stream, args.fap)
         console.status(f"wrote {args.fap} ({stream.n_frames} frames, {stream.duration:.2f} s)")
     written = render(source, face=_face_path(args.face), out=out, width=args.width,
+                     framing=args.framing,
                      height=args.height, audio=args.audio, fps=args.fps,
                      progress=console.progress("rendering"))
     console.status(f"wrote {written} in {time.perf_counter() - started:.1f} s")

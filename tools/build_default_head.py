@@ -22,12 +22,16 @@ What it does:
    (the renderer has no ambient occlusion);
 4. places the MPEG-4 feature points with geometric rules, helped by the ARKit face targets of
    the same wheel (which vertices a jaw opening, a blink, a brow raise moves);
-5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots.
+5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots;
+6. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
+   fap_targets.csv`` names (the ``field`` deformer): stored in the mesh file as
+   ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex.
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import io
 import json
 import zipfile
@@ -61,6 +65,11 @@ IRIS_RIM = (0.12, 0.18, 0.22)
 PUPIL = (0.02, 0.02, 0.02)
 TEETH = (0.93, 0.91, 0.84)
 TONGUE = (0.78, 0.38, 0.42)
+# painted eyebrows: colour, half-heights (metres) at the inner, middle and outer brow points,
+# how far past the outer point the tail runs, and the soft edge
+BROW = (0.30, 0.20, 0.15)
+BROW_HALF = (0.0045, 0.0035, 0.0018)
+BROW_TAIL, BROW_SOFT = 0.006, 0.0015
 
 
 # ---------------------------------------------------------------------------- reading the wheel
@@ -535,8 +544,11 @@ def build(wheel_path: Path) -> None:
     # the cavity darkens with depth behind the lips
     depth = np.clip((pos[fp["8.3"], 2] - pos[skin[inside], 2]) / MOUTH_FADE, 0.0, 1.0)[:, None]
     skin_c[inside] = np.array(MOUTH) * (1.0 - (1.0 - MOUTH_DEEP) * depth)
+    paint_brows(pos, skin_c, fp, n_skin)
     cols[:n_skin] = skin_c
 
+    field_regions, fields = learned_fields(pos, fp, skin_target=skin_target, n_skin=n_skin)
+    fields.update(expression_mixes(skin_target=skin_target, n_skin=n_skin))
     regions = make_regions(
         pos,
         skin,
@@ -547,7 +559,7 @@ def build(wheel_path: Path) -> None:
         mouth_y=mouth_y,
         x_corner=x_corner,
         eyes={s: (m(eyes[s][0]), eyes[s][1] * SCALE) for s in ("l", "r")},
-    )
+    ) + field_regions
 
     pivots = {
         "eye_l": m(eyes["l"][0]).tolist(),
@@ -583,12 +595,36 @@ def build(wheel_path: Path) -> None:
         vertices=verts.astype(np.float32),
         triangles=tris.astype(np.int32),
         vertex_colors=np.round(cols * 255).astype(np.uint8),
+        **fields,
     )
     (OUT_DIR / "default_head.json").write_text(json.dumps(definition, indent=1) + "\n")
     print(
         f"{len(verts)} vertices, {len(tris)} triangles, {len(fp)} feature points, "
         f"{len(regions)} regions"
     )
+
+
+def paint_brows(pos, skin_c, fp, n_skin):
+    """Eyebrows as vertex colours along the brow feature points (inner 4.1/4.2, middle
+    4.3/4.4, outer 4.5/4.6): a band whose height tapers from inner to outer, soft-edged, so
+    it rides on the skin and follows every brow FAP."""
+    skin = np.arange(n_skin)
+    for ids, sgn in ((("4.1", "4.3", "4.5"), 1.0), (("4.2", "4.4", "4.6"), -1.0)):
+        pts = pos[[fp[i] for i in ids]]
+        xs = sgn * pts[:, 0]
+        x = sgn * pos[skin, 0]
+        front = (pos[skin, 2] > pts[:, 2].min() - 0.012) & (x > xs[0] - 0.003) & (
+            x < xs[2] + BROW_TAIL)
+        # brow centre line y(x) through the three points (quadratic), its half-height by x
+        coef = np.polyfit(xs, pts[:, 1], 2)
+        centre = np.polyval(coef, x)
+        half = np.interp(x, [xs[0], xs[1], xs[2], xs[2] + BROW_TAIL],
+                         [*BROW_HALF, 0.0003])
+        # the inner end is rounded, not cut: fade over 3 mm from the inner point inward
+        inner = np.clip((x - (xs[0] - 0.003)) / 0.003, 0.0, 1.0)
+        t = np.clip((half - np.abs(pos[skin, 1] - centre)) / BROW_SOFT + 0.5, 0.0, 1.0)
+        alpha = 0.92 * (t * t * (3 - 2 * t)) * inner * front
+        skin_c[:] = (1 - alpha[:, None]) * skin_c + alpha[:, None] * np.array(BROW)
 
 
 def mouth_interior(pos, tris, n, *, blocked, seed):
@@ -762,6 +798,60 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
             }
         )
     return regions
+
+
+FIELD_BLEND = 0.006  # metres each side of the midline over which a one-sided field fades
+FIELD_MIN = 1e-5  # metres: displacements below this (at target weight 1) are dropped
+
+
+def fap_target_rows() -> list[dict[str, str]]:
+    path = ROOT / "facelib" / "data" / "head" / "fap_targets.csv"
+    lines = [ln for ln in path.read_text("utf-8").splitlines() if not ln.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+def learned_fields(pos, fp, *, skin_target, n_skin):
+    """One ``field`` region per row of fap_targets.csv, and its ``(Vr, 3)`` float32 array."""
+    from facelib.mpeg4.tables import fap as fap_info
+
+    regions, arrays = [], {}
+    x = pos[:n_skin, 0]
+    for row in fap_target_rows():
+        info = fap_info(row["fap"])
+        field = np.zeros((n_skin, 3))
+        for term in row["targets"].split("+"):
+            scale, _, name = term.rpartition("*")
+            field += float(scale or 1.0) * skin_target(name.strip(), vectors=True)
+        if row["side"] != "both":
+            sgn = 1.0 if row["side"] == "left" else -1.0
+            t = np.clip((sgn * x + FIELD_BLEND) / (2 * FIELD_BLEND), 0.0, 1.0)
+            field *= (t * t * (3 - 2 * t))[:, None]
+        point = fp[info.feature_points[0]]
+        members = np.nonzero(np.linalg.norm(field, axis=1) > FIELD_MIN)[0]
+        along = float(field[point] @ np.asarray(info.direction))
+        share = abs(along) / max(float(np.linalg.norm(field[point])), 1e-12)
+        print(f"field {info.name}: {len(members)} vertices, feature point moves "
+              f"{1000 * np.linalg.norm(field[point]):.1f} mm, {share:.0%} along the FAP")
+        key = f"field_{info.name}"
+        arrays[key] = field[members].astype(np.float32)
+        regions.append({"name": key, "deformer": "field",
+                        "feature_points": [info.feature_points[0]],
+                        "params": {"fap": info.name}, "field": key, "targets": row["targets"],
+                        "note": row["note"], "vertices": members.tolist()})
+    return regions, arrays
+
+
+def expression_mixes(*, skin_target, n_skin):
+    """``mix_<expression>``: (n_skin, 3) float32 skin displacement (metres) of each mix of
+    expression_mixes.csv, the references that tools/fit_expressions.py fits FAPs to."""
+    path = ROOT / "facelib" / "data" / "head" / "expression_mixes.csv"
+    lines = [ln for ln in path.read_text("utf-8").splitlines() if not ln.startswith("#")]
+    mixes: dict[str, np.ndarray] = {}
+    for row in csv.DictReader(lines):
+        key = f"mix_{row['expression']}"
+        mixes.setdefault(key, np.zeros((n_skin, 3)))
+        mixes[key] += float(row["weight"]) * skin_target(row["target"], vectors=True)
+    return {k: v.astype(np.float32) for k, v in mixes.items()}
 
 
 def main() -> None:

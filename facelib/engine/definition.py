@@ -18,8 +18,8 @@ import numpy as np
 from facelib import data
 from facelib.engine.face import PART_NAMES, RIGID_DEFORMERS, Face, Region
 from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
-from facelib.errors import FaceModelError, ParameterError
-from facelib.mpeg4.tables import fap_table, feature_point_table
+from facelib.errors import FacelibError, FaceModelError, ParameterError
+from facelib.mpeg4.tables import fap, fap_table, feature_point_table
 
 __all__ = ["FORMAT", "VERSION", "load_face", "required_feature_points"]
 
@@ -101,6 +101,7 @@ class _Reader:
         self.path = path
         self.doc = doc
         self.overrides = overrides
+        self.fields: dict[str, np.ndarray] = {}  # the mesh file's field_* arrays
 
     def fail(self, message: str) -> FaceModelError:
         return FaceModelError(message, path=self.path)
@@ -138,6 +139,7 @@ class _Reader:
         try:
             with np.load(mesh_path, allow_pickle=False) as data:
                 arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
+                self.fields = {k: data[k] for k in data.files if k.startswith("field_")}
         except (OSError, ValueError) as exc:
             raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
         except KeyError as exc:
@@ -242,6 +244,29 @@ class _Reader:
                                  f"of {self.path.name} (known: {', '.join(known)})")
         return tuple(out)
 
+    def field(self, item: dict[str, Any], where: str, *, deformer: str,
+              params: dict[str, Any], controls: list[str], n_members: int) -> np.ndarray:
+        """A ``field`` region's ``(Vr, 3)`` displacements from the mesh file (empty for other
+        deformers); its ``params["fap"]`` must move the region's one feature point."""
+        if deformer != "field":
+            return np.zeros((0, 3), np.float32)
+        try:
+            info = fap(str(params.get("fap")))
+        except FacelibError as exc:
+            raise self.fail(f"{where}: a field region names the FAP it drives in params.fap, "
+                            f"got {params.get('fap')!r}") from exc
+        if info.kind != "translation" or list(info.feature_points[:1]) != controls:
+            raise self.fail(f"{where}: field FAP {info.name} moves {info.feature_points}, "
+                            f"not the region's feature points {controls}")
+        key = item.get("field")
+        if not isinstance(key, str) or key not in self.fields:
+            raise self.fail(f"{where}: the mesh file has no field array {key!r}")
+        array = np.asarray(self.fields[key], dtype=np.float32)
+        if array.shape != (n_members, 3) or not np.all(np.isfinite(array)):
+            raise self.fail(f"{where}: field {key!r} must be finite ({n_members}, 3), got "
+                            f"{array.shape}")
+        return array
+
     def region(self, item: dict, nv: int, points: dict[str, int],
                pivots: dict[str, np.ndarray]) -> Region:
         """One region of the definition, validated, with its deformer resolved."""
@@ -275,9 +300,12 @@ class _Reader:
             pivot = str(item.get("pivot"))
             if pivot not in pivots:
                 raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
+        displacements = self.field(item, where, deformer=deformer, params=params,
+                                   controls=controls, n_members=vertices.size)
         return Region(name=name, deformer=deformer, feature_points=tuple(controls),
                       vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
-                      pivot=pivot, params=MappingProxyType(params), group=group, custom=custom)
+                      pivot=pivot, params=MappingProxyType(params), group=group, custom=custom,
+                      displacements=displacements)
 
     def deformer_of(self, item: dict, name: str, group: str, where: str
                     ) -> tuple[str, Deformer | None, dict[str, Any]]:

@@ -18,6 +18,10 @@ __all__ = ["explicit_weights", "raised_cosine_weights", "rbf_weights"]
 RAISED_COSINE_W = 0.5
 """The constant w of eq. 4.7: with 0.5 the feature point itself moves by exactly its dFP."""
 
+EDGE_RADIUS_MIN = 0.25
+"""An edge closer to the feature point than this fraction of the region's extent means the
+point lies on (or next to) the edge: the falloff then spans the whole region instead."""
+
 
 def raised_cosine_weights(
     members: np.ndarray, controls: np.ndarray, *, edge: np.ndarray | None = None
@@ -31,7 +35,10 @@ def raised_cosine_weights(
     A region is seldom a disc around its point: with ``edge`` given, ``d_max`` is instead the
     distance to the nearest of those edge vertices (members next to the rest of the mesh),
     and members farther out stay still, so the surface is continuous (with zero slope) where
-    the region meets the rest of the mesh instead of creasing there.
+    the region meets the rest of the mesh instead of creasing there. A feature point on the
+    region's own edge (nearest edge vertex closer than ``EDGE_RADIUS_MIN`` of the farthest
+    member) would leave no room to fall off, so there ``d_max`` is the farthest member's
+    distance, as in the thesis.
 
     Parameters
     ----------
@@ -44,8 +51,14 @@ def raised_cosine_weights(
     (Vr, N) float64 weights in [0, 1].
     """
     d = cdist(members, controls)
-    d_max = d.max(axis=0) if edge is None or not len(edge) else cdist(edge, controls).min(axis=0)
-    d_max[d_max == 0] = 1.0
+    far = d.max(axis=0)
+    if np.any(far == 0):
+        raise FaceModelError("a raised-cosine region has no extent: every member sits on its "
+                             "feature point")
+    d_max = far
+    if edge is not None and len(edge):
+        near = cdist(edge, controls).min(axis=0)
+        d_max = np.where(near >= EDGE_RADIUS_MIN * far, near, far)
     w = (1.0 + np.cos(np.pi * np.clip(d / d_max, 0.0, 1.0))) * RAISED_COSINE_W
     return w / controls.shape[0]
 

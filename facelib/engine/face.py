@@ -9,8 +9,10 @@ Deformation of one frame ``f`` (84 FAP values):
 2. eyelids (FAP 19-22) rotate over the eyeball about the eye centre, by the angle that
    moves their feature point vertically by ``f_j * IRISD``, each vertex by its weight;
 3. eyeballs rotate about their centres (FAP 23-26) and move forward (FAP 27-28);
-4. lower teeth and tongue follow the jaw: a hinge rotation that drops the chin point 2.1 by
-   ``f_3 * MNS`` plus the thrust (FAP 14) and shift (FAP 15) translations;
+4. lower teeth and tongue follow the jaw: a hinge rotation that moves the lower-lip point
+   2.3 vertically as the skin operator moves it per unit of FAP 3 (so the lower teeth stay
+   behind the lower lip, whatever deformer opens the jaw; with a plain jaw region that is the
+   chin's drop of ``f_3 * MNS``) plus the thrust (FAP 14) and shift (FAP 15) translations;
 5. the head rotates about its pivot (FAP 48-50), fading to nothing over the neck.
 
 FAPs 1-2 (high-level visemes and expressions) are decoded into low-level FAPs by ``deform``
@@ -82,6 +84,8 @@ class Region:
     params: the deformer's parameters as the definition (or an override) gives them.
     group: an optional group name (``"lips"``) that overrides may use instead of the name.
     custom: a :class:`~facelib.engine.registry.Deformer` given directly instead of a name.
+    displacements: (Vr, 3) float32 learned target displacements of the members (``field``
+        regions, which name their FAP in ``params["fap"]``; empty otherwise).
     """
 
     name: str
@@ -94,6 +98,12 @@ class Region:
     params: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     group: str = ""
     custom: Deformer | None = None
+    displacements: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+
+    @property
+    def field_fap(self) -> str:
+        """The FAP a ``field`` region drives alone ("" for other regions)."""
+        return str(self.params.get("fap", "")) if self.deformer == "field" else ""
 
     @property
     def algorithm(self) -> Deformer:
@@ -144,7 +154,8 @@ class _Rigid:
     jaw_y: np.ndarray
     jaw_z: np.ndarray
     jaw_pivot: np.ndarray
-    chin: np.ndarray
+    chin: np.ndarray  # the point the hinge follows (2.3, the lower lip)
+    chin_drop: float  # its downward motion per unit of FAP 3 in the skin operator
     head_pivot: np.ndarray
     head_tiled: np.ndarray  # (3V,) float32, the pivot repeated per vertex
     head_weights: np.ndarray  # (K,) float32 for the neck vertices
@@ -224,7 +235,7 @@ class Face:
         columns = np.unique(operator.indices).astype(np.int64)
         dense = operator[:, columns].toarray().astype(np.float32)
         rigid_parts = _rigid(verts, fps, fapu, regions=regions, parts=part_map,
-                             pivots=pivot_map, neck=neck)
+                             pivots=pivot_map, neck=neck, operator=operator)
         return cls(
             vertices=verts,
             triangles=tris,
@@ -252,6 +263,25 @@ class Face:
     @property
     def n_vertices(self) -> int:
         return int(self.vertices.shape[0])
+
+    @property
+    def fap_deformers(self) -> Mapping[str, str]:
+        """FAP name -> the deformer that moves its feature point's surroundings: ``"field"``
+        where a learned field drives the FAP alone, else the deformers of the regions its
+        feature point controls (joined by ``+``); FAPs that move no region are left out."""
+        out: dict[str, str] = {}
+        fields = {r.field_fap for r in self.regions if r.field_fap}
+        for f in fap_table():
+            if f.name in fields:
+                out[f.name] = "field"
+                continue
+            if f.kind != "translation" or not f.feature_points:
+                continue
+            kinds = sorted({r.deformer for r in self.regions if r.deformer != "field"
+                            and f.feature_points[0] in r.feature_points})
+            if kinds:
+                out[f.name] = "+".join(kinds)
+        return MappingProxyType(out)
 
     def deform(self, stream: FapStream) -> np.ndarray:
         """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``.
@@ -347,7 +377,7 @@ class Face:
         if not (open_.any() or thrust.any() or shift.any()):
             return
         flat = pos.reshape(len(f), -1)
-        angle = rigid.hinge_angle(r.chin, r.jaw_pivot, -open_ * self.fapu["MNS"])
+        angle = rigid.hinge_angle(r.chin, r.jaw_pivot, -open_ * r.chin_drop)
         y, z = rigid.rotate_about_x(flat[:, r.jaw_y], flat[:, r.jaw_z], r.jaw_pivot[1],
                                     r.jaw_pivot[2], angle[:, None])
         flat[:, r.jaw_y] = y
@@ -409,6 +439,13 @@ class _Step:
         flat[:, self.columns] += (exact - dc @ self.linear).astype(np.float32)
 
 
+def _jaw_drop(operator: sp.csr_array, point: int, mns: float) -> float:
+    """How far the skin operator lowers vertex ``point`` per unit of FAP 3 (``MNS`` when
+    nothing in the operator moves it, so the teeth still open with the FAP)."""
+    dy = -float(operator[:, [point * 3 + 1]].toarray()[2, 0])
+    return dy if dy > 0 else mns
+
+
 def _region_weights(
     region: Region, pos: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int]
 ) -> tuple[np.ndarray, FrameStep | None]:
@@ -419,7 +456,8 @@ def _region_weights(
         controls=np.array([fps[f] for f in region.feature_points], np.int64),
         anchors=region.anchors.astype(np.int64), vertices=pos, triangles=triangles,
         weights=region.weights.astype(np.float64),
-        params=MappingProxyType(algo.resolve(region.params, region=region.name)))
+        params=MappingProxyType(algo.resolve(region.params, region=region.name)),
+        displacements=region.displacements.astype(np.float64))
     w = np.asarray(algo.weights(setup), dtype=np.float64)
     vr, n = setup.members.size, setup.controls.size
     if w.shape == (vr, n):
@@ -441,6 +479,8 @@ def _compile(
     pos = verts.astype(np.float64)
     tris = triangles.astype(np.int64)
     motion = _fp_motion(fapu)
+    # a FAP that a learned field drives moves that field's region and no other
+    owned = {fap(r.field_fap).index for r in regions if r.field_fap}
     rows, cols, vals = [], [], []
     steps = []
     for region in regions:
@@ -448,11 +488,13 @@ def _compile(
             continue
         w, step = _region_weights(region, pos, tris, fps)
         members = region.vertices.astype(np.int64)
+        mine = {fap(region.field_fap).index} if region.field_fap else None
         # g: (84, N, 3) control displacement per FAP unit
         g = np.zeros((N_FAPS, len(region.feature_points), 3))
         for k, fp_id in enumerate(region.feature_points):
             for index, scale in motion.get(fp_id, ()):
-                g[index, k] += scale
+                if (index in mine) if mine is not None else (index not in owned):
+                    g[index, k] += scale
         block = np.einsum("vaib,fib->fva", w, g)  # (84, Vr, 3)
         fi, vi, ai = np.nonzero(block)
         rows.append(fi)
@@ -521,8 +563,8 @@ def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
 
 def _rigid(verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float], *,
            regions: tuple[Region, ...], parts: Mapping[str, Part],
-           pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float]
-           ) -> _Rigid:
+           pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float],
+           operator: sp.csr_array) -> _Rigid:
     """The rigid steps' precomputed columns, offsets and weights (eyes, lids, jaw, head)."""
     head = pivots["head"]
     point, normal, blend = neck
@@ -544,7 +586,8 @@ def _rigid(verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
         jaw_y=_columns(jaw_ids, "y"),
         jaw_z=_columns(jaw_ids, "z"),
         jaw_pivot=pivots["jaw"],
-        chin=verts[fps["2.1"]].astype(np.float64),
+        chin=verts[fps["2.3"]].astype(np.float64),
+        chin_drop=_jaw_drop(operator, fps["2.3"], fapu["MNS"]),
         head_pivot=head,
         head_tiled=np.tile(head.astype(np.float32), len(verts)),
         head_weights=head_w[head_w < 1.0].astype(np.float32),

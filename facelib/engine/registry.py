@@ -47,6 +47,7 @@ class RegionSetup:
     triangles: (F, 3) int64 triangles of the skin (the surface the region lies on).
     weights: (Vr,) float64 explicit weights (``weights`` deformer; empty otherwise).
     params: the region's deformer parameters, defaults filled in.
+    displacements: (Vr, 3) float64 learned target displacements (``field``; else empty).
     """
 
     name: str
@@ -57,6 +58,7 @@ class RegionSetup:
     triangles: np.ndarray
     weights: np.ndarray
     params: Mapping[str, Any]
+    displacements: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def fail(self, message: str) -> FaceModelError:
         return FaceModelError(f"region {self.name!r}: {message}")
@@ -149,7 +151,7 @@ def _explicit(setup: RegionSetup) -> np.ndarray:
 
 def _builtin() -> tuple[Deformer, ...]:
     # imported here: the frame-based and interpolation modules import this one
-    from facelib.engine import frame_deformers, interpolation
+    from facelib.engine import fields, frame_deformers, interpolation
 
     return (
         Deformer(
@@ -167,6 +169,7 @@ def _builtin() -> tuple[Deformer, ...]:
                  "face definition"),
         *interpolation.DEFORMERS,
         *frame_deformers.DEFORMERS,
+        *fields.DEFORMERS,
     )
 
 

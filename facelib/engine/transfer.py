@@ -229,13 +229,15 @@ class _Mapper:
         return out
 
     def region(self, region: Region, fps: Mapping[str, int]) -> Region:
-        members, weights = [], []
+        members, weights, moves = [], [], []
         for name, sub in self._by_part(region.vertices.astype(np.int64)).items():
             block = self.blocks[name]
             if isinstance(block, _Carried):
                 members.append(block.offset + self.local_of[sub])
                 if region.weights.size:
                     weights.append(region.weights[np.isin(region.vertices, sub)])
+                if region.displacements.size:
+                    moves.append(region.displacements[np.isin(region.vertices, sub)])
                 continue
             assert isinstance(block, _Dense)
             indicator = np.zeros(block.guide.shape[0])
@@ -250,10 +252,23 @@ class _Mapper:
                 field[self.local_of[sub]] = region.weights[np.isin(region.vertices, sub)]
                 value = block.match.interpolate(block.guide_surface, field)[keep]
                 weights.append(np.clip(value / np.maximum(inside[keep], 0.5), 0.0, 1.0))
+            if region.displacements.size:  # a learned field: each axis like a weight
+                axes = []
+                for axis in range(3):
+                    field = np.zeros(block.guide.shape[0])
+                    field[self.local_of[sub]] = region.displacements[
+                        np.isin(region.vertices, sub), axis]
+                    value = block.match.interpolate(block.guide_surface, field)[keep]
+                    axes.append(value / np.maximum(inside[keep], 0.5))
+                moves.append(np.stack(axes, axis=1))
         ids = np.concatenate(members)
         order = np.argsort(ids, kind="stable")
         ids, first = np.unique(ids[order], return_index=True)
         w = np.concatenate(weights)[order][first] if weights else np.zeros(0)
+        d = (np.concatenate(moves)[order][first] if moves
+             else np.zeros((0, 3))).astype(np.float32)
+        if region.deformer == "field":
+            ids, d = _with_point(ids, d, fps[region.feature_points[0]], self)
         anchors = np.zeros(0, np.int64)
         if region.anchors.size:
             controls = [fps[f] for f in region.feature_points]
@@ -263,4 +278,17 @@ class _Mapper:
                       feature_points=region.feature_points, vertices=ids.astype(np.int32),
                       anchors=anchors.astype(np.int32), weights=w.astype(np.float32),
                       pivot=region.pivot, params=region.params, group=region.group,
-                      custom=region.custom)
+                      custom=region.custom, displacements=d)
+
+
+def _with_point(ids: np.ndarray, moves: np.ndarray, point: int, mapper: object
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """A transferred field keeps its feature point as a member: if the mapped members miss
+    it, it joins with the displacement of the nearest member."""
+    if np.isin(point, ids):
+        return ids, moves
+    del mapper
+    at = int(np.searchsorted(ids, point))
+    near = min(max(at, 0), len(ids) - 1)
+    return (np.insert(ids, at, point),
+            np.insert(moves, at, moves[near] if len(moves) else 0.0, axis=0))

@@ -42,6 +42,8 @@ def face_document(face: Face, *, mesh: str, name: str, source: str = "") -> dict
             item["anchors"] = [int(v) for v in r.anchors]
         if r.deformer in ("weights", "eyelid"):
             item["weights"] = [round(float(w), 6) for w in r.weights]
+        if r.deformer == "field":
+            item["field"] = f"field_{r.name}"
         if r.pivot:
             item["pivot"] = r.pivot
         if r.group:
@@ -76,8 +78,12 @@ def write_face(face: Face, path: str | Path, *, name: str = "", source: str = ""
     doc = face_document(face, mesh=mesh_path.name, name=name or path.stem, source=source)
     text = json.dumps(doc, indent=1) + "\n"
     buffer = io.BytesIO()
-    np.savez_compressed(buffer, vertices=face.vertices, triangles=face.triangles,
-                        vertex_colors=np.round(face.vertex_colors * 255).astype(np.uint8))
+    fields = {f"field_{r.name}": r.displacements for r in face.regions
+              if r.deformer == "field"}
+    arrays: dict[str, np.ndarray] = {
+        "vertices": face.vertices, "triangles": face.triangles,
+        "vertex_colors": np.round(face.vertex_colors * 255).astype(np.uint8), **fields}
+    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
     with atomic_path(mesh_path) as temp:
         temp.write_bytes(buffer.getvalue())
     write_text_atomic(path, text)

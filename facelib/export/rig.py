@@ -147,7 +147,7 @@ def pose_rig(face: Face, rig: Rig, stream: FapStream) -> Pose:
             f[:, pitch - 1] * au, f[:, yaw - 1] * au, np.zeros(n)))
         trans[:, j, 2] += (f[:, thrust - 1] * face.fapu["ES"]).astype(np.float32)
     jaw = rig.names.index("jaw")
-    rot[:, jaw] = _about_x(rigid.hinge_angle(r.chin, r.jaw_pivot, -f[:, 2] * face.fapu["MNS"]))
+    rot[:, jaw] = _about_x(rigid.hinge_angle(r.chin, r.jaw_pivot, -f[:, 2] * r.chin_drop))
     trans[:, jaw, 2] += (f[:, 13] * face.fapu["MNS"]).astype(np.float32)
     trans[:, jaw, 0] -= (f[:, 14] * face.fapu["MW"]).astype(np.float32)
     first = jaw + 1

@@ -108,6 +108,7 @@ def render(
     background: Sequence[float] | None = None,
     progress: bool | ProgressCallback | None = True,
     fps: float | None = None,
+    framing: str | np.ndarray = "face",
 ) -> np.ndarray | Path:
     """Render an animation of ``face`` driven by ``source``.
 
@@ -124,15 +125,13 @@ def render(
     width, height: image size in pixels (even for ``.mp4``).
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
-    background: sRGB colour in [0, 1] behind the face; None uses the look's.
+    background: sRGB colour behind the face (None: the look's). framing: see FaceRenderer.
     progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
         None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
     fps: resample the stream to this frame rate first (None keeps the stream's).
 
-    Returns
-    -------
-    ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the written
-    path. The camera is framed once on the neutral face and stays put.
+    Returns ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the
+    written path. The camera is framed once on the neutral face and stays put.
     """
     stream, source_audio, source_offset = stream_of(source)
     if fps is not None:
@@ -141,13 +140,15 @@ def render(
     offset = source_offset if audio_offset is None else float(audio_offset)
     face = face_or_default(face, source)
     if out is not None and Path(out).suffix.lower() == ".png":
-        return _one_png(face, stream, out, width=width, height=height, background=background)
+        return _one_png(face, stream, out, width=width, height=height, background=background,
+                        framing=framing)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
     with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
         if audio is None and out is not None and Path(out).suffix.lower() == ".mp4":
             audio = speech_audio_file(source, Path(folder) / "speech.wav")
-        with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+        with FaceRenderer(face, width=width, height=height, background=background,
+                          framing=framing) as renderer:
             frames = iter_frames(renderer, face, stream, progress=progress)
             if out is None:
                 return np.stack(list(frames)) if stream.n_frames else np.empty(
@@ -159,7 +160,7 @@ def render(
 
 def _one_png(
     face: Deformable, stream: FapStream, out: str | os.PathLike[str], *, width: int,
-    height: int, background: Sequence[float] | None,
+    height: int, background: Sequence[float] | None, framing: str | np.ndarray = "face",
 ) -> Path:
     """A single-frame stream rendered to the PNG ``out``."""
     if stream.n_frames != 1:
@@ -168,7 +169,7 @@ def _one_png(
             "give a folder to write one PNG per frame"
         )
     return save_png(render_still(face, stream.values[0], width=width, height=height,
-                                 background=background), out)
+                                 background=background, framing=framing), out)
 
 
 def _write(
@@ -195,8 +196,9 @@ def render_still(
     width: int = 640,
     height: int = 480,
     background: Sequence[float] | None = None,
+    framing: str | np.ndarray = "face",
 ) -> np.ndarray:
-    """One ``(height, width, 3) uint8`` image of ``face``.
+    """One ``(height, width, 3) uint8`` image of ``face`` (``framing`` as in :func:`render`).
 
     ``pose`` is an ``(84,)`` FAP vector (deformed with ``face.deform_frame``), a ``(V, 3)``
     vertex array, or None for the neutral face. For many stills of one face, keep a
@@ -215,5 +217,6 @@ def render_still(
             raise ParameterError(
                 f"pose must be ({N_FAPS},) FAP values or (V, 3) vertices, got {pose.shape}"
             )
-    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+    with FaceRenderer(face, width=width, height=height, background=background,
+                      framing=framing) as renderer:
         return renderer.frame(vertices)

@@ -15,8 +15,9 @@ background) lives in ``facelib/data/render_look.json``.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
+from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
@@ -27,8 +28,17 @@ from facelib.errors import FaceModelError, ParameterError, RenderError
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
 
-__all__ = ["FaceRenderer", "Look", "PartMesh", "frame_camera", "load_look", "split_parts",
-           "vertex_normals"]
+__all__ = [
+    "FRAMINGS",
+    "FaceRenderer",
+    "Look",
+    "PartMesh",
+    "frame_camera",
+    "framing_points",
+    "load_look",
+    "split_parts",
+    "vertex_normals",
+]
 
 
 # -- look (data) -------------------------------------------------------------------------
@@ -44,6 +54,7 @@ class Look:
     background: tuple[float, float, float]
     yfov_deg: float
     margin: float
+    framings: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
     def material(self, part: str) -> Mapping[str, float]:
         return self.parts.get(part, self.parts["default"])
@@ -60,7 +71,39 @@ def load_look() -> Look:
         background=tuple(raw["background"]),
         yfov_deg=float(raw["camera"]["yfov_deg"]),
         margin=float(raw["camera"]["margin"]),
+        framings=MappingProxyType(raw.get("framings", {})),
     )
+
+
+FRAMINGS = ("face", "head", "bust")
+"""Named framings of :class:`FaceRenderer` (defined in ``render_look.json``)."""
+
+
+def framing_points(face: Any, name: str, *, look: Look | None = None) -> np.ndarray:
+    """``(K, 3) float32`` points whose bounding box the camera frames for framing ``name``.
+
+    ``face`` needs ``vertices``; ``"face"`` also needs ``feature_points`` (id -> vertex) with
+    the look's points, and falls back to the whole mesh (``"head"``) when it lacks them.
+    """
+    look = look or load_look()
+    if name not in look.framings:
+        raise ParameterError(f"framing must be one of {tuple(look.framings)} or an (N, 3) "
+                             f"array, got {name!r}")
+    spec = look.framings[name]
+    vertices = np.asarray(face.vertices, np.float32)
+    fps = getattr(face, "feature_points", {}) or {}
+    wanted = spec.get("feature_points", [])
+    if spec.get("all_vertices") or not all(k in fps for k in wanted):
+        box = vertices
+    else:
+        box = vertices[[fps[k] for k in wanted]]
+    lo, hi = box.min(axis=0), box.max(axis=0)
+    height = float(hi[1] - lo[1])
+    top = np.array([(lo[0] + hi[0]) / 2, hi[1] + float(spec.get("above", 0.0)) * height,
+                    (lo[2] + hi[2]) / 2], np.float32)
+    bottom = top.copy()
+    bottom[1] = lo[1] - float(spec.get("below", 0.0)) * height
+    return np.vstack([box, top, bottom]).astype(np.float32)
 
 
 # -- geometry (pure numpy) ---------------------------------------------------------------
@@ -287,7 +330,8 @@ class FaceRenderer:
         in [0, 1] and ``parts`` (name -> object with ``triangles``), e.g. ``facelib`` ``Face``.
     width, height: image size in pixels.
     background: sRGB colour behind the face; None takes the look's.
-    framing: ``(V, 3)`` vertices to frame the camera on (default: the neutral face).
+    framing: a named framing (``"face"``, the default: brow to chin fills over half the
+        frame height; ``"head"``; ``"bust"``) or ``(N, 3)`` points to frame the camera on.
     mesh_update: ``"buffers"`` rewrites vertex buffers in place (fast), ``"swap"`` replaces the
         mesh nodes each frame.
     """
@@ -299,7 +343,7 @@ class FaceRenderer:
         width: int = 640,
         height: int = 480,
         background: Sequence[float] | None = None,
-        framing: np.ndarray | None = None,
+        framing: np.ndarray | str | None = "face",
         look: Look | None = None,
         mesh_update: Literal["buffers", "swap"] = "buffers",
         offscreen: bool = True,
@@ -327,6 +371,10 @@ class FaceRenderer:
         self._interleaved = [np.empty((len(c), 10), np.float32) for c in self._colors]
         for buf, color in zip(self._interleaved, self._colors, strict=True):
             buf[:, 6:10] = color
+        if framing is None:
+            framing = "head"
+        if isinstance(framing, str):
+            framing = framing_points(face, framing, look=self.look)
         self.scene = self._build_scene(vertices, background, framing)
         self._renderer = None
         self._primitives: list[Any] = []

@@ -6,7 +6,8 @@ Each step is a small pure function over :class:`FapTrack` objects:
 2. :func:`blend` the result with gaze (eyelid and head conflict, 25 % gaze);
 3. :func:`close_lids` for blinks, which no expression may hold open;
 4. :func:`add_head_noise` where gaze does not move the head;
-5. :func:`to_stream`.
+5. nods on the stressed syllables (:mod:`facelib.sync.nods`), likewise;
+6. :func:`to_stream`.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import ANGLE_UNIT, fap
 from facelib.mpeg4.track import FapTrack
+from facelib.sync.nods import accents, add_nods
 from facelib.sync.noise import perlin1d
 from facelib.sync.rules import HeadNoise, SyncRules
 
@@ -29,8 +31,11 @@ _UPPER_LIDS = (fap("close_t_l_eyelid").index, fap("close_t_r_eyelid").index)
 _LOWER_LIDS = (fap("close_b_l_eyelid").index, fap("close_b_r_eyelid").index)
 
 
-def blend(a: FapTrack, b: FapTrack, *, weight_a: float, weight_b: float) -> FapTrack:
+def blend(a: FapTrack, b: FapTrack, *, weight_a: float | np.ndarray,
+          weight_b: float | np.ndarray) -> FapTrack:
     """Weighted blend of two tracks.
+
+    weight_a, weight_b: one weight for every FAP, or ``(84,)`` arrays of per-FAP weights.
 
     Per frame and FAP: ``(wa*A + wb*B) / (wa + wb)`` with ``wa = weight_a * a.weight`` and
     ``wb = weight_b * b.weight``. Where only one track drives a FAP, its value is kept as
@@ -130,14 +135,18 @@ def combine(
     """
     seed = check_seed(seed)
     rules = rules or SyncRules.load()
-    face = blend(expressions, visemes, weight_a=rules.mouth[0], weight_b=rules.mouth[1])
+    mouth_e, mouth_v = rules.mouth_weights()
+    face = blend(expressions, visemes, weight_a=mouth_e, weight_b=mouth_v)
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
     if blinks is not None:
         if blink_lids is None:
             raise ParameterError("combine: blinks need blink_lids (GazeAnimation.blink_lids)")
         face = close_lids(face, blinks, closed=blink_lids)
+    head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
     if rules.head_noise is not None:
-        head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
         face = add_head_noise(face, noise=rules.head_noise, seed=seed,
                               head_driven=head_driven, speaking=speaking)
+    if rules.speech_nods is not None:
+        face = add_nods(face, strength=accents(visemes, nods=rules.speech_nods),
+                        nods=rules.speech_nods, seed=seed, head_driven=head_driven)
     return to_stream(face)

@@ -29,8 +29,10 @@ from facelib.visemes.coarticulation import (
     frame_times_ms,
     speaking_mask,
 )
+from facelib.visemes.loudness import jaw_gain
 from facelib.visemes.mapping import with_visemes
 from facelib.visemes.scripts import visemes_from_cues
+from facelib.visemes.tables import loudness_rules, timing_rules
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
 __all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate",
@@ -167,8 +169,11 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     """Mouth, jaw and tongue FAP curves for ``speech``.
 
     Frame i of the track is at ``i / fps`` s of the storyboard; the track ends at the last
-    frame inside the speech. Values come from the coarticulation blend of the viseme
-    targets; weights are the speech envelope on the driven FAPs (0 elsewhere).
+    frame of the envelope's release ramp after the speech. Values come from the
+    coarticulation blend of the viseme targets, faded to neutral with the speech envelope,
+    which is also the weight on the driven FAPs (0 elsewhere): weights and values fade
+    together, so a lone viseme track eases out instead of dropping to 0 in one frame.
+    Louder speech opens the jaw further (:mod:`facelib.visemes.loudness`).
     ``rate`` multiplies the speech's own speaking rate; ``language`` is the storyboard's.
     Speech longer than ``max_frames`` raises SpeechError before the curves are computed.
     """
@@ -176,19 +181,22 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     rate = check_number("rate", rate, low=0.25, high=4.0)
     own, audio = _spoken(speech, rate=rate, language=language)
     timeline = own.shifted(speech.start_ms)
-    end_ms = speech.start_ms + timeline.duration_ms
+    # through the envelope's release ramp, so the mouth is seen settling back to neutral
+    end_ms = speech.start_ms + timeline.duration_ms + timing_rules()["envelope_ramp_ms"]
     n_frames = math.floor(end_ms * fps / 1000) + 1
     if n_frames > max_frames:
         path, line = speech.origin if speech.origin else (None, None)
         raise SpeechError(f"speech lasts {end_ms} ms = {n_frames} frames at {fps:g} fps, more "
                           f"than max_frames={max_frames}", path=path, line=line)
     times = frame_times_ms(n_frames, fps)
-    values = blend(timeline.visemes, times)
+    loudness = _frame_loudness(speech, own, audio, times - speech.start_ms)
+    env = envelope(timeline.visemes, times)
+    gain = jaw_gain(loudness, rules=loudness_rules())
+    values = blend(timeline.visemes, times, jaw_gain=gain) * env[:, None]
     weight = np.zeros_like(values)
-    weight[:, driven_faps()] = envelope(timeline.visemes, times)[:, None]
+    weight[:, driven_faps()] = env[:, None]
     speaking = speaking_mask(timeline.visemes, times)
     speaking.flags.writeable = False
-    loudness = _frame_loudness(speech, own, audio, times - speech.start_ms)
     return VisemeAnimation(FapTrack(fps, values, weight), timeline.visemes, speaking, timeline,
                            audio, loudness)
 

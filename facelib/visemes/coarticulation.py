@@ -16,6 +16,7 @@ from facelib.mpeg4.tables import N_FAPS, fap
 from facelib.visemes.tables import (
     coarticulation_classes,
     dominance_table,
+    lower_lip_per_jaw,
     timing_rules,
     viseme_targets,
 )
@@ -57,14 +58,17 @@ def window_ms() -> float:
     return 1000.0 * float(np.log(ratio / _NEGLIGIBLE)) / theta
 
 
-def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
+def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray, *,
+          jaw_gain: np.ndarray | None = None) -> np.ndarray:
     """FAP values ``(len(times_ms), 84) float32`` (FAP units) of the viseme sequence.
 
     For each FAP class k (jaw, lip height, lip shape, tongue) and span s the dominance is
     ``alpha_sk * exp(-theta_sk * d)``, d the distance in seconds from the time to the span
     (0 inside it; ``theta_before`` before it, ``theta_after`` after it). Each FAP is the
     dominance-weighted mean of the spans' targets. The lips then close on every p/b/m
-    (see ``_close_bilabials``). FAPs outside the classes stay 0.
+    (see ``_close_bilabials``). FAPs outside the classes stay 0. ``jaw_gain``
+    (``(len(times_ms),)``, from the speech's loudness) scales the jaw opening before the
+    bilabial closure, so p/b/m still close.
 
     Frames are taken in chunks, each with the spans within :func:`window_ms` of it only, so
     memory and time grow linearly with the length of the speech (``times_ms`` ascending).
@@ -84,6 +88,8 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
         last = max(int(np.searchsorted(start, t.max() + reach, side="right")), first + 1)
         part = slice(first, last)
         out[lo:lo + t.size] = _blend_dense(ids[part], start[part], end[part], t)
+    if jaw_gain is not None:
+        out[:, fap("open_jaw").index] *= np.asarray(jaw_gain, np.float32)
     _close_bilabials(out, visemes, times, reach)
     return out
 
@@ -115,7 +121,8 @@ def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.n
                      reach: float) -> None:
     """Make the lips meet on every p/b/m, whatever the jaw does (speakers close the lips
     with the jaw part open): inside the span the lip heights are the closure's, and the
-    lower lip rises by the jaw's extra opening (the jaw carries the lower lip; both in MNS).
+    lower lip rises by the jaw's extra opening (the jaw carries the lower lip,
+    ``lower_lip_per_jaw`` MNS per jaw unit).
     The correction fades outside the span with the bilabial's own dominance fall-off, so
     the lips close smoothly; the frame nearest a span shorter than a frame is closed too.
     Only frames within ``reach`` ms of the span are touched (beyond, the fade is nil)."""
@@ -141,7 +148,7 @@ def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.n
             c[int(np.argmin(np.abs(t - centre)))] = 1.0
         block = out[lo:hi]
         block[:, lip] += c[:, None] * (targets[_BILABIAL, lip][None, :] - block[:, lip])
-        extra = np.maximum(block[:, jaw] - targets[_BILABIAL, jaw], 0.0)
+        extra = lower_lip_per_jaw() * np.maximum(block[:, jaw] - targets[_BILABIAL, jaw], 0.0)
         block[:, lower] += (c * extra)[:, None]
 
 

@@ -72,13 +72,17 @@ def merge_short_silences(
 
 
 def enforce_min_duration(
-    visemes: Sequence[VisemeSpan], *, min_ms: int | None = None
+    visemes: Sequence[VisemeSpan], *, min_ms: int | None = None, merge_below_ms: int | None = None
 ) -> tuple[VisemeSpan, ...]:
     """Lengthen spans shorter than ``min_ms`` (default: the data file's ``min_visible_ms``)
     by taking time from neighbours that can spare it (they stay at least ``min_ms`` long).
-    A span that still cannot be seen is merged into its longer neighbour, except a
-    bilabial (p b m), whose closure must show: its neighbour gives way instead."""
-    min_len = timing_rules()["min_visible_ms"] if min_ms is None else min_ms
+    A span that still falls short keeps the time it has, so the dominance blend leaves a
+    visible trace of it; only one shorter than ``merge_below_ms`` (default: the data file's
+    ``merge_below_ms``, the aligner's noise) is merged into its longer neighbour, and never
+    a bilabial (p b m), whose closure must show: its neighbour gives way instead."""
+    rules = timing_rules()
+    min_len = rules["min_visible_ms"] if min_ms is None else min_ms
+    merge_below = rules["merge_below_ms"] if merge_below_ms is None else merge_below_ms
     out = list(visemes)
     # Fix the first span that is too short, then look again from just before it: a fix
     # only touches that span and its neighbours, and never makes an earlier span too short
@@ -91,6 +95,9 @@ def enforce_min_duration(
             i += 1
             continue
         need = _borrow(out, i, need, min_len)
+        if need > 0 and out[i].duration_ms >= merge_below:
+            i += 1  # kept short: a trace of it shows
+            continue
         if need > 0:
             _merge(out, i)
         i = max(i - 2, 0)

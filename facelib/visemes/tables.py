@@ -35,6 +35,8 @@ __all__ = [
     "PhoneViseme",
     "coarticulation_classes",
     "dominance_table",
+    "loudness_rules",
+    "lower_lip_per_jaw",
     "phone_viseme",
     "script_name",
     "timing_rules",
@@ -162,6 +164,19 @@ def dominance_table() -> Mapping[tuple[int, str], Dominance]:
                 raise DataError(f"non-positive dominance for {name}/{cls}", path=path)
             out[vid, cls] = dom
     return MappingProxyType(out)
+
+
+@cache
+def loudness_rules() -> Mapping[str, float]:
+    """The ``loudness`` rules of the data file (see :mod:`facelib.visemes.loudness`)."""
+    raw = _coarticulation()["loudness"]
+    return MappingProxyType({k: float(v) for k, v in raw.items() if not k.startswith("_")})
+
+
+@cache
+def lower_lip_per_jaw() -> float:
+    """MNS of lower-lip drop per unit of open_jaw (``lower_lip_per_jaw`` of the data file)."""
+    return float(_coarticulation().get("lower_lip_per_jaw", 1.0))
 
 
 @cache

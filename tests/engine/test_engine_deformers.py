@@ -61,3 +61,17 @@ def test_rbf_is_smooth_between_sources() -> None:
 def test_rbf_needs_distinct_sources() -> None:
     with pytest.raises(FaceModelError):
         rbf_weights(np.zeros((2, 3)), np.zeros((1, 3)), np.zeros((1, 3)))
+
+
+def test_raised_cosine_with_its_point_on_the_edge_falls_off_over_the_region():
+    """Issue 14: a feature point on its region's edge used to give a 1 m radius (the region
+    moved rigidly); now the falloff spans the region, the point moves fully, the far side
+    not at all, and a region with no extent is an error."""
+    members = np.array([[0.0, 0, 0], [0.005, 0, 0], [0.010, 0, 0], [0.015, 0, 0]])
+    w = raised_cosine_weights(members, members[:1], edge=members[[0, 3]])[:, 0]
+    np.testing.assert_allclose(w, [1.0, 0.75, 0.25, 0.0], atol=1e-12)
+    # an edge far enough away still sets the radius
+    w = raised_cosine_weights(members, members[1:2], edge=members[[3]])[:, 0]
+    np.testing.assert_allclose(w[[1, 3]], [1.0, 0.0], atol=1e-12)
+    with pytest.raises(FaceModelError, match="no extent"):
+        raised_cosine_weights(members[:1], members[:1], edge=members[:1])

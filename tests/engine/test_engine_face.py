@@ -92,13 +92,19 @@ def test_translation_fap_moves_its_point(face: Face, fap_id: int, fap_frame) -> 
         centre = face.pivots["eye_l" if fap_id in (19, 21) else "eye_r"]
         assert np.linalg.norm(moved[p] - centre) == pytest.approx(
             np.linalg.norm(rest[p] - centre), rel=1e-5)
+    elif face.fap_deformers.get(f.name) == "field":
+        # eq. 4.6 exactly along the FAP's direction; the learned field decides the rest
+        direction = np.asarray(f.direction, dtype=np.float64)
+        assert delta @ direction == pytest.approx(expected @ direction, rel=1e-4)
     else:
         assert delta == pytest.approx(expected, rel=0.01, abs=1e-3 * np.abs(expected).max())
     # far from the feature point nothing moves (but the jaw carries teeth and tongue)
     far = np.linalg.norm(rest - rest[p], axis=1) > 0.09
     if fap_id in (3, 14, 15):
         far[face.parts["teeth_lower"].vertex_ids] = far[face.parts["tongue"].vertex_ids] = False
-    assert np.abs(moved[far] - rest[far]).max() < 1e-7
+    # a learned field may reach further (a brow lowerer folds the forehead), but fades there
+    limit = 0.2 * np.linalg.norm(delta) if face.fap_deformers.get(f.name) == "field" else 1e-7
+    assert np.abs(moved[far] - rest[far]).max() < limit
 
 
 def test_deformation_is_linear_in_translation_faps(face: Face, fap_frame) -> None:
@@ -168,7 +174,17 @@ def test_lips_part_by_the_jaw_displacement(face: Face, fap_frame) -> None:
     up, lo = face.feature_points["2.2"], face.feature_points["2.3"]
     gap0 = face.vertices[up, 1] - face.vertices[lo, 1]
     gap1 = moved[up, 1] - moved[lo, 1]
-    assert gap1 - gap0 == pytest.approx(drop, rel=0.05)
+    if face.fap_deformers["open_jaw"] == "field":
+        # the jaw swings: the chin point drops by the FAP, the lower lip (further from the
+        # hinge's axis in depth) drops further, as the ARKit jawOpen target says
+        assert drop < gap1 - gap0 < 2.0 * drop
+        # and the lower teeth stay behind the lower lip: the hinge follows the lip's drop
+        teeth = face.parts["teeth_lower"].vertex_ids
+        incisor = teeth[np.argmax(face.vertices[teeth, 1] + face.vertices[teeth, 2])]
+        lip_drop = face.vertices[lo, 1] - moved[lo, 1]
+        assert face.vertices[incisor, 1] - moved[incisor, 1] == pytest.approx(lip_drop, rel=0.15)
+    else:
+        assert gap1 - gap0 == pytest.approx(drop, rel=0.05)
     # the upper lip stays: no vertex of the upper lip follows the lower one (at the corners
     # and inside the mouth the shared lining stretches with the jaw)
     upper = next(r for r in face.regions if r.name == "upper_lip").vertices
@@ -176,7 +192,10 @@ def test_lips_part_by_the_jaw_displacement(face: Face, fap_frame) -> None:
     upper = upper[(np.abs(face.vertices[upper, 0]) < abs(corner[0]) - 0.002)
                   & (face.vertices[upper, 2] > corner[2])]
     assert upper.size > 100
-    assert np.abs(moved[upper] - face.vertices[upper]).max() < 0.05 * drop
+    # (the jawOpen field stretches the lip lining next to the corners a little)
+    field = face.fap_deformers["open_jaw"] == "field"
+    assert np.abs(moved[upper] - face.vertices[upper]).max() < (0.5 if field else 0.05) * drop
+    assert abs(moved[up, 1] - face.vertices[up, 1]) < 0.05 * drop  # the upper midlip stays
     # lower teeth and tongue ride with the jaw, upper teeth stay
     for part, moves in (("teeth_lower", True), ("tongue", True), ("teeth_upper", False)):
         ids = face.parts[part].vertex_ids

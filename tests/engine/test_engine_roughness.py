@@ -21,9 +21,13 @@ from facelib.mpeg4.visemes import viseme_names
 from facelib.visemes.tables import viseme_targets
 
 # reference C.1: lip-region mean roughness per viseme at full intensity on the default head
-VISEME_PINS = {"sil": 0.09484, "PP": 0.09510, "FF": 0.09190, "TH": 0.08563, "DD": 0.08692,
-               "kk": 0.08446, "CH": 0.09782, "SS": 0.09259, "nn": 0.08588, "RR": 0.09802,
-               "aa": 0.08814, "E": 0.09497, "ih": 0.12211, "oh": 0.09584, "ou": 0.12973}
+# after issue 14 (jaw as the jawOpen field, lip-corner stretch as the mouthStretch field at
+# the inner corners, viseme jaw and stretch values rescaled to match): the lips of ih, ou
+# and CH are smoother than before, those of the tongue and lip consonants (FF-kk) and oh up
+# to 0.009 rougher (the jaw field's wider motion); none above 0.12
+VISEME_PINS = {"sil": 0.09484, "PP": 0.09629, "FF": 0.09805, "TH": 0.09339, "DD": 0.09434,
+               "kk": 0.09352, "CH": 0.09496, "SS": 0.09644, "nn": 0.09378, "RR": 0.09668,
+               "aa": 0.09042, "E": 0.09555, "ih": 0.10204, "oh": 0.10509, "ou": 0.11731}
 
 
 @pytest.fixture(scope="module")

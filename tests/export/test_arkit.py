@@ -88,9 +88,12 @@ def test_round_trip_keeps_mouth_brow_and_lid_curves(hello_csv, hello):
         r = np.corrcoef(a[name], b[name])[0, 1]
         assert r >= 0.9, f"{name}: correlation {r:.3f}"
     # the FAP curves themselves: jaw, brows, upper lids
-    for name in ("open_jaw", "raise_l_i_eyebrow", "raise_r_o_eyebrow", "close_t_l_eyelid"):
+    # (issue 14's refitted library moves the inner brows little in the hello demo, so that
+    # curve is small and its round trip noisier: 0.75 there)
+    for name, least in (("open_jaw", 0.9), ("raise_l_i_eyebrow", 0.75),
+                        ("raise_r_o_eyebrow", 0.9), ("close_t_l_eyelid", 0.9)):
         j = fap(name).index
-        assert np.corrcoef(hello.faps.values[:, j], back.values[:, j])[0, 1] >= 0.9, name
+        assert np.corrcoef(hello.faps.values[:, j], back.values[:, j])[0, 1] >= least, name
     # head and eye angles go through the extra columns (6 decimals of a radian)
     for name in ("head_yaw", "head_pitch", "yaw_l_eyeball", "pitch_r_eyeball"):
         j = fap(name).index

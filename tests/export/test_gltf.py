@@ -51,8 +51,10 @@ def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
                for p in g.meshes[0].primitives for t in p.targets)
     skin = g.meshes[0].primitives[0]
     moved = [g.accessors[t["POSITION"]].sparse for t in skin.targets]
-    assert all(s is not None and 0 < s.count < 0.5 * g.accessors[skin.attributes.POSITION].count
-               for s in moved)  # sparse: each target moves a part of the skin
+    # sparse: each target moves a part of the skin (the learned jaw field of issue 14, the
+    # widest, moves about half of it)
+    assert all(s is not None and 0 < s.count < 0.6 * g.accessors[skin.attributes.POSITION].count
+               for s in moved)
     assert [p.material for p in g.meshes[0].primitives] == list(range(6))
     extras = g.asset.extras["facelib"]
     assert extras["n_frames"] == 12 and extras["fps"] == 25

@@ -51,13 +51,18 @@ def test_golden_stream():
     assert np.abs(golden.values - stream.values).max() <= 0.5
 
 
-def test_expressions_and_visemes_share_the_mouth_as_eq_4_11():
+def test_expressions_and_visemes_share_the_mouth_by_the_per_fap_weights():
+    """Eq. 4.11 with the per-FAP weights of facelib/data/sync.json (the jaw leans on the
+    viseme, the lip corners on the expression)."""
+    from facelib.sync import SyncRules
+
     anim = run_fdl(DATA / "small.fdl")
     e, v = anim.tracks["expressions"], anim.tracks["visemes"]
+    we, wv = SyncRules.load().mouth_weights()
     col = fap("open_jaw").index
     both = (e.weight[:, col] == 1) & (v.weight[:, col] == 1)
     assert both.any()
-    expected = (e.values[both, col] + 3 * v.values[both, col]) / 4
+    expected = (we[col] * e.values[both, col] + wv[col] * v.values[both, col]) / (we[col] + wv[col])
     assert np.allclose(anim.faps.values[both, col], expected, atol=1e-3)
 
 

@@ -114,3 +114,24 @@ def test_closed_lids_cover_the_whole_eye(fap_frame):
             white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
     assert white[0] > 500
     assert white[1] < 0.03 * white[0]
+
+
+def test_named_framings_and_the_default_face_close_up():
+    """Issue 14: the default frames the face (brow to chin over half the frame height);
+    'head' and 'bust' step back; an unknown name is an error."""
+    from facelib.errors import ParameterError
+
+    face = engine.load_face(None)
+    fp = face.feature_points
+    spans = {}
+    for name in ("face", "head", "bust"):
+        with FaceRenderer(face, width=320, height=240, framing=name) as renderer:
+            (_, brow), (_, chin) = renderer.project(face.vertices[[fp["4.3"], fp["2.1"]]])
+            spans[name] = (chin - brow) / 240
+    with FaceRenderer(face, width=320, height=240) as renderer:
+        (_, brow), (_, chin) = renderer.project(face.vertices[[fp["4.3"], fp["2.1"]]])
+    assert (chin - brow) / 240 == pytest.approx(spans["face"])
+    assert spans["face"] >= 0.5
+    assert spans["face"] > spans["head"] > spans["bust"] > 0.15
+    with pytest.raises(ParameterError, match="framing must be one of"):
+        FaceRenderer(face, width=64, height=64, framing="shoulders")

@@ -15,7 +15,7 @@ W, H = 160, 120
 
 @pytest.fixture(scope="module")
 def renderer(synthetic_face):
-    with FaceRenderer(synthetic_face, width=W, height=H) as r:
+    with FaceRenderer(synthetic_face, width=W, height=H, framing="head") as r:
         yield r
 
 

@@ -18,7 +18,7 @@ def default_head_render() -> tuple[np.ndarray, dict[str, np.ndarray]]:
     from facelib.rendering import FaceRenderer
 
     face = default_face()
-    with FaceRenderer(face, width=640, height=480) as renderer:
+    with FaceRenderer(face, width=640, height=480, framing="head") as renderer:
         image = renderer.frame(face.vertices)
         ids = sorted(face.feature_points)
         proj = renderer.project(face.vertices[[face.feature_points[k] for k in ids]])

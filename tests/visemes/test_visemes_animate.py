@@ -45,7 +45,8 @@ def test_stored_viseme_script_used_directly():
             VisemeCue("Q", 720, 40), VisemeCue("silence", 760, 1080))
     anim = animate(SpeechSpec(visemes=cues), fps=25)
     assert [v.name for v in anim.timeline][:3] == ["sil", "aa", "kk"]
-    assert anim.speech.source == "script" and anim.track.n_frames == 47
+    # 1840 ms of script and the 150 ms release ramp
+    assert anim.speech.source == "script" and anim.track.n_frames == 50
     jaw = anim.track.values[:, fap("open_jaw").index]
     assert jaw[int(0.56 * 25)] == pytest.approx(viseme_targets()[10, fap("open_jaw").index],
                                                 rel=0.05)
@@ -58,7 +59,7 @@ def test_audio_and_text_uses_alignment():
                       text="The quick brown fox jumps over the lazy dog.", start_ms=500)
     anim = animate(spec, fps=25)
     assert anim.speech.source == "forced"
-    assert anim.track.n_frames == int((500 + anim.speech.duration_ms) * 25 / 1000) + 1
+    assert anim.track.n_frames == int((500 + anim.speech.duration_ms + 150) * 25 / 1000) + 1
     first = next(v for v in anim.timeline if not v.is_silence)
     assert abs(first.start_ms - (500 + 165)) <= 40
 

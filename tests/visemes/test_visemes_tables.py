@@ -68,9 +68,11 @@ def test_targets_match_viseme_definitions():
     # aa is the widest open; ou rounded and protruded; ih spread
     jaw = viseme_targets()[:, fap("open_jaw").index]
     assert int(np.argmax(jaw)) == viseme_id("aa")
-    assert v("ou", "push_t_lip") > 200 and v("ou", "stretch_l_cornerlip") < -200
+    # (lip-corner stretch is on the inner corners only, at half the value: on the default
+    # head it drives the learned mouthStretch field, which moves the outer corner too)
+    assert v("ou", "push_t_lip") > 200 and v("ou", "stretch_l_cornerlip") < -150
     assert v("oh", "open_jaw") > v("ou", "open_jaw")
-    assert v("ih", "stretch_l_cornerlip") > 150 and v("E", "stretch_l_cornerlip") > 100
+    assert v("ih", "stretch_l_cornerlip") > 100 and v("E", "stretch_l_cornerlip") > 75
     # silence is the neutral face
     assert not viseme_targets()[0].any()
 
