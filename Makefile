@@ -29,7 +29,7 @@ lint: $(VENV)/.installed
 
 # Figures, not pass/fail: each benchmark prints what it measured.
 bench: $(VENV)/.installed
-	for b in engine_deform render_speed gaze_simulate fdl_sandbox visemes_align_accuracy; do \
+	for b in engine_deform engine_deformers render_speed gaze_simulate fdl_sandbox visemes_align_accuracy; do \
 		PYTHONPATH=. $(BIN)/python benchmarks/$$b.py || exit 1; done
 
 clean:

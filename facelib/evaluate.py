@@ -193,7 +193,8 @@ def summary_table(ev: Evaluation) -> list[dict[str, Any]]:
 
 def _markdown(ev: Evaluation) -> str:
     table = summary_table(ev)
-    ranked = sorted(table, key=lambda r: r["syllables_mean"])
+    key = "syllables_mean" if not np.isnan(table[0]["syllables_mean"]) else "visemes_mean"
+    ranked = sorted(table, key=lambda r: r[key])
     lines = [
         ("| rank | deformer | visemes mean | visemes var | expressions mean | syllables mean "
          "| syllables var | worst viseme / rbf | max flipped | linearised vs exact (mm) |"),
@@ -207,8 +208,9 @@ def _markdown(ev: Evaluation) -> str:
             f"{r['syllables_var']:.3g} | {r['worst_viseme_ratio']:.3f} | {r['max_flipped']} "
             f"| {lin} |")
     lines.append("")
-    lines.append(f"Lip region at rest: {ev.rest:.5f}. Ranked by the syllables' mean, as the "
-                 "seed's table E.1.")
+    what = "syllables'" if key == "syllables_mean" else "visemes'"
+    lines.append(f"Lip region at rest: {ev.rest:.5f}. Ranked by the {what} mean (the seed's "
+                 "table E.1 ranks by the syllables').")
     return "\n".join(lines) + "\n"
 
 
