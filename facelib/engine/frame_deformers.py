@@ -69,7 +69,7 @@ class FrameMap:
         n = dc.shape[0]
         moved = np.broadcast_to(self.mesh.sources, (n, *self.mesh.sources.shape)).copy()
         moved[:, : self.n_controls] += dc
-        rest_pos = self._place(np.broadcast_to(self.mesh.sources, moved.shape))
+        rest_pos = self._place(self.mesh.sources[None])
         new_pos = self._place(moved)
         blend = sp.csr_array((self.u, (self.member, np.arange(self.u.size))),
                              shape=(self.n_members, self.u.size))
