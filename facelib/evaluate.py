@@ -215,18 +215,21 @@ def _markdown(ev: Evaluation) -> str:
 
 
 def write_evaluation(ev: Evaluation, folder: str | Path, *, sheet: bool = True,
-                     stem: str = "deformers", face_path: str | Path | None = None
-                     ) -> list[Path]:
-    """Write ``<stem>.csv`` (every pose), ``<stem>.md`` (the summary), ``<stem>_frames.csv``
-    (the seed's per-frame rows) and, with ``sheet``, ``<stem>_mouths.png``. Returns paths."""
+                     frames: bool = True, stem: str = "deformers",
+                     face_path: str | Path | None = None) -> list[Path]:
+    """Write ``<stem>.csv`` (every pose), ``<stem>.md`` (the summary), with ``frames``
+    ``<stem>_frames.csv`` (the seed's per-frame rows) and with ``sheet``
+    ``<stem>_mouths.png``. Returns the paths written."""
     folder = Path(folder)
-    out = [folder / f"{stem}.csv", folder / f"{stem}.md", folder / f"{stem}_frames.csv"]
+    out = [folder / f"{stem}.csv", folder / f"{stem}.md"]
     write_text_atomic(out[0], _csv(("deformer", "kind", "pose", "mean", "min", "max",
                                     "flipped"), ev.rows))
     write_text_atomic(out[1], _markdown(ev))
-    frames = [(name, *row) for name, rows in ev.reports.items() for row in rows]
-    write_text_atomic(out[2], _csv(("deformer", "frame", "time_s", "point", "min", "max",
-                                    "mean"), frames))
+    if frames:
+        out.append(folder / f"{stem}_frames.csv")
+        rows = [(name, *row) for name, report in ev.reports.items() for row in report]
+        write_text_atomic(out[-1], _csv(("deformer", "frame", "time_s", "point", "min", "max",
+                                         "mean"), rows))
     if sheet:
         out.append(folder / f"{stem}_mouths.png")
         write_contact_sheet(list(dict.fromkeys(r[0] for r in ev.rows)), out[-1],
