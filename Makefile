@@ -9,8 +9,7 @@ EXTRAS ?= all
 demo: $(VENV)/.installed
 	$(BIN)/facelib render examples/hello/hello.fdl -o out/hello.mp4 --fap out/hello.fap
 
-test: $(VENV)/.installed
-	$(BIN)/ruff check .
+test: lint
 	$(BIN)/python -m pytest
 
 setup: $(VENV)/.installed
@@ -24,8 +23,10 @@ $(VENV)/.installed: pyproject.toml tools/debian-packages.txt tools/debian-deps
 	$(BIN)/python -m pip install --quiet -e ".[$(EXTRAS)]"
 	touch $@
 
+# ruff (style, complexity) and mypy (types; settings in pyproject.toml's [tool.mypy]).
 lint: $(VENV)/.installed
 	$(BIN)/ruff check .
+	$(BIN)/mypy
 
 # Figures, not pass/fail: each benchmark prints what it measured.
 bench: $(VENV)/.installed

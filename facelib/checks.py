@@ -1,18 +1,22 @@
 """Argument checks shared by every public function: one message per kind of mistake.
 
-Each returns the value converted to a plain Python number, or raises
+Each check returns the value converted to a plain Python number, or raises
 :class:`~facelib.errors.ParameterError` naming the argument and the value.
+:func:`did_you_mean` is the one "did you mean ..." hint used by every error message
+that names an unknown word (FAP names, expressions, FDL keywords, eye behaviours, ...).
 """
 
 from __future__ import annotations
 
+import difflib
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
 from facelib.errors import ParameterError
 
-__all__ = ["check_count", "check_fps", "check_number"]
+__all__ = ["check_count", "check_fps", "check_number", "did_you_mean"]
 
 
 def check_number(name: str, value: object, *, low: float | None = None,
@@ -49,3 +53,16 @@ def check_count(name: str, value: object, *, low: int = 0) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
         raise ParameterError(f"{name} must be an integer >= {low}, got {value!r}")
     return int(value)
+
+
+def did_you_mean(word: str, choices: Iterable[str], *, cutoff: float = 0.7) -> str:
+    """``"; did you mean 'x'?"`` for the closest of ``choices`` to ``word``, or ``""``.
+
+    Case is ignored when comparing (``speaksound`` suggests ``speakSound``); ``word`` itself
+    is never suggested. ``cutoff`` is :func:`difflib.get_close_matches`' similarity ratio in
+    ``[0, 1]``: 0.7 keeps one-letter slips (``joyy`` -> ``joy``) and drops unrelated words
+    (``nope`` does not suggest ``inlove``).
+    """
+    options = {c.lower(): c for c in choices if c != word}
+    close = difflib.get_close_matches(word.lower(), list(options), n=1, cutoff=cutoff)
+    return f"; did you mean '{options[close[0]]}'?" if close else ""

@@ -13,7 +13,16 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-__all__ = ["ExpressionCue", "GazeCue", "Origin", "SpeechSpec", "Storyboard", "VisemeCue"]
+__all__ = [
+    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "ExpressionCue", "GazeCue", "Origin", "SpeechSpec",
+    "Storyboard", "VisemeCue",
+]
+
+MAX_FRAMES = 360_000
+"""Most frames an animation may have unless the caller raises it (``animate(max_frames=)``):
+four hours at 25 fps. Checked before any per-frame array is allocated."""
+MAX_SPEECH_TEXT_CHARS = 100_000
+"""Longest text of one speech cue (about two hours of speech)."""
 
 Origin = tuple[str, int]
 """(file, 1-based line) of the script text a cue came from."""
@@ -128,7 +137,7 @@ class Storyboard:
     def cues_end_ms(self) -> int:
         """End of the last expression, gaze or stored-viseme cue (speech audio may last
         longer; the animation pipeline takes the longest track)."""
-        ends = [c.end_ms for c in (*self.expressions, *self.gaze)]
+        ends = [c.end_ms for c in self.expressions] + [c.end_ms for c in self.gaze]
         if self.speech is not None and self.speech.visemes:
             ends += [c.end_ms for c in self.speech.visemes]
         return max(ends, default=0)

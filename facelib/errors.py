@@ -21,6 +21,8 @@ __all__ = [
     "RenderError",
     "SpeechError",
     "SpeechWarning",
+    "TrackingError",
+    "TrackingWarning",
 ]
 
 
@@ -78,6 +80,11 @@ class RenderError(FacelibError):
     """Rendering or video encoding failed (no OpenGL platform, encoder error, ...)."""
 
 
+class TrackingError(FacelibError):
+    """A video or landmark track cannot be turned into FAPs (no face, unreadable video,
+    wrong point count, missing feature points); the message names the frames."""
+
+
 class MissingExtraError(FacelibError, ImportError):
     """An optional dependency is needed for this feature but is not installed."""
 
@@ -94,3 +101,7 @@ class FacelibWarning(UserWarning):
 
 class SpeechWarning(FacelibWarning):
     """An alignment succeeded but looks implausible (named word, reason)."""
+
+
+class TrackingWarning(FacelibWarning):
+    """Tracking went on but lost the face in some frames, or saw several faces (names them)."""

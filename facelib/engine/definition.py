@@ -260,7 +260,7 @@ class _Reader:
                 if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
                     raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
             if deformer == "eyelid":
-                pivot = item.get("pivot")
+                pivot = str(item.get("pivot"))
                 if pivot not in pivots:
                     raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
             out.append(Region(name=name, deformer=deformer, feature_points=tuple(controls),

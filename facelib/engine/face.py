@@ -45,7 +45,7 @@ _BLOCK = 32  # frames deformed together
 
 
 def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
-    out = np.array(array, dtype=dtype, copy=True)
+    out: np.ndarray = np.array(array, dtype=dtype, copy=True)
     out.flags.writeable = False
     return out
 

@@ -25,6 +25,7 @@ Both compile as their linearisation at rest (a central-difference Jacobian of th
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -209,7 +210,7 @@ def _check_mode(setup: RegionSetup) -> None:
         raise setup.fail(f"mode must be 'linearised' or 'exact', got {setup.params['mode']!r}")
 
 
-def _weights(kind: str):  # type: ignore[no-untyped-def]
+def _weights(kind: str) -> Callable[[RegionSetup], np.ndarray]:
     def weights(setup: RegionSetup) -> np.ndarray:
         _check_mode(setup)
         return linearise(frame_map(setup, kind=kind))
@@ -217,7 +218,7 @@ def _weights(kind: str):  # type: ignore[no-untyped-def]
     return weights
 
 
-def _step(kind: str):  # type: ignore[no-untyped-def]
+def _step(kind: str) -> Callable[[RegionSetup], FrameStep]:
     def step(setup: RegionSetup) -> FrameStep:
         return FrameStep(frame_map(setup, kind=kind).displace)
 

@@ -7,21 +7,23 @@ with a note on where each value comes from). Storyboards add or override express
 
 from __future__ import annotations
 
-import csv
-import difflib
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from types import MappingProxyType
 
 import numpy as np
 
+from facelib import data
+from facelib.checks import did_you_mean
 from facelib.cues import Origin
-from facelib.errors import FdlError, ParameterError
+from facelib.errors import DataError, FdlError, ParameterError
 from facelib.mpeg4.tables import N_FAPS, fap
 
 __all__ = ["Expression", "ExpressionLibrary", "default_library"]
+
+# FAP values at full intensity by FAP name or 1-based id, in FAP units.
+FapValues = Mapping[str, float] | Mapping[int, float] | Mapping[str | int, float]
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,7 +39,7 @@ class Expression:
     mask: np.ndarray
 
     @classmethod
-    def from_faps(cls, name: str, faps: Mapping[str | int, float]) -> Expression:
+    def from_faps(cls, name: str, faps: FapValues) -> Expression:
         """Build from ``{FAP name or id: value}``; unknown FAPs raise ``ParameterError``."""
         values = np.zeros(N_FAPS, np.float32)
         mask = np.zeros(N_FAPS, bool)
@@ -78,15 +80,14 @@ class ExpressionLibrary:
         found = self.expressions.get(name.lower())
         if found is not None:
             return found
-        close = difflib.get_close_matches(name.lower(), self.names, n=1)
-        hint = f"; did you mean {close[0]!r}?" if close else ""
+        hint = did_you_mean(name, self.names)
         path, line = origin if origin is not None else (None, None)
         raise FdlError(f"unknown expression {name!r}{hint} (known: {', '.join(self.names)})",
                        path=path, line=line)
 
     def with_defs(
         self,
-        defs: Mapping[str, Mapping[str | int, float]],
+        defs: Mapping[str, FapValues],
         *,
         mixes: Mapping[str, Mapping[str, float]] | None = None,
     ) -> ExpressionLibrary:
@@ -109,23 +110,25 @@ class ExpressionLibrary:
             faps: dict[str | int, float] = {
                 int(i) + 1: float(values[i]) for i in np.flatnonzero(mask)
             }
-            faps.update(defs.get(name, {}))
+            faps.update(defs.get(name, {}).items())
             merged[name.lower()] = Expression.from_faps(name.lower(), faps)
-        for name, faps in defs.items():
+        for name, own in defs.items():
             if name not in (mixes or {}):
-                merged[name.lower()] = Expression.from_faps(name.lower(), faps)
+                merged[name.lower()] = Expression.from_faps(name.lower(), own)
         return ExpressionLibrary(MappingProxyType(merged))
 
 
 @cache
 def default_library() -> ExpressionLibrary:
     """The expressions shipped with facelib (read once)."""
-    table: dict[str, dict[str, float]] = {}
-    source = resources.files("facelib.data").joinpath("expressions.csv")
-    with source.open(encoding="utf-8", newline="") as f:
-        rows = csv.DictReader(line for line in f if not line.startswith("#"))
-        for row in rows:
-            table.setdefault(row["expression"], {})[row["fap"]] = float(row["value"])
+    table: dict[str, dict[str | int, float]] = {}
+    for line, row in data.csv_rows("expressions.csv"):
+        try:
+            value = float(row["value"])
+        except ValueError:
+            raise DataError(f"value {row['value']!r} is not a number",
+                            path=str(data.path("expressions.csv")), line=line) from None
+        table.setdefault(row["expression"], {})[row["fap"]] = value
     return ExpressionLibrary(
         MappingProxyType({name: Expression.from_faps(name, faps) for name, faps in table.items()})
     )

@@ -13,13 +13,13 @@ import math
 from pathlib import Path
 from typing import Any
 
+from facelib.checks import did_you_mean
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard, VisemeCue
 from facelib.errors import FdlError
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.modern import FUNCTIONS, DraftCue, DraftSpeech, ModernParts, read_calls
 from facelib.fdl.paths import read_text, resolve_inside
 from facelib.fdl.sandbox import WHITELIST, ChunkResult, Sandbox
-from facelib.fdl.suggest import did_you_mean
 from facelib.fdl.thesis import SCRIPT_GLOBALS, check_fdl_table, sequence
 from facelib.fdl.values import LuaTable, to_python
 from facelib.fdl.visemes import check_viseme
@@ -31,6 +31,7 @@ log = logging.getLogger("facelib.fdl")
 DEFAULT_FPS = 25.0
 SETTINGS = ("fps", "seed", "output", "FDL", "expressions", "eyes", "Sentence")
 """Globals a storyboard may set (besides its own helpers and variables)."""
+_MIN_FPS = 1.0
 _MAX_FPS = 1000.0
 
 
@@ -158,10 +159,10 @@ def _build(
     if (
         isinstance(fps, bool)
         or not isinstance(fps, int | float)
-        or not (math.isfinite(fps) and 0 < fps <= _MAX_FPS)
+        or not (math.isfinite(fps) and _MIN_FPS <= fps <= _MAX_FPS)
     ):
         raise FdlError(
-            f"fps must be a number above 0 and at most {_MAX_FPS:g}; got {fps!r}",
+            f"fps must be a number from {_MIN_FPS:g} to {_MAX_FPS:g}; got {fps!r}",
             path=name,
             line=fps_line,
         )
@@ -178,7 +179,8 @@ def _build(
             lists[list_name] = (value, ctx)
     if fdl is not None:
         for field_name, list_name in SCRIPT_GLOBALS.items():
-            if fdl.get(field_name) is None:
+            script = fdl.get(field_name)
+            if script is None:
                 continue
             where = ctx.line_of(field_name, after=fdl_line)
             if list_name in lists:
@@ -188,7 +190,7 @@ def _build(
                     line=where,
                 )
             lists[list_name] = _sub_script(
-                fdl[field_name], list_name, ctx, where, seed=seed, box=box
+                script, list_name, ctx, where, seed=seed, box=box
             )
 
     calls = []
@@ -225,6 +227,8 @@ def _build(
             base_dir, output_value, what="output", path=name, line=output_line, must_exist=False
         )
     )
+    if output is not None:
+        _check_output(output, inputs=(file, *_inputs_of(speech)), path=name, line=output_line)
     return Storyboard(
         path=file,
         fps=float(fps),
@@ -237,6 +241,30 @@ def _build(
         output=output,
         expression_mixes=parts.expression_mixes,
     )
+
+
+OUTPUT_SUFFIXES = (".fap", ".mp4", ".gif")
+"""What a storyboard's ``output`` may name: the files facelib writes."""
+
+
+def _inputs_of(speech: SpeechSpec | None) -> tuple[Path, ...]:
+    if speech is None or speech.audio is None:
+        return ()
+    return (Path(speech.audio),)
+
+
+def _check_output(output: Path, *, inputs: tuple[Path | None, ...], path: str,
+                  line: int | None) -> None:
+    """A storyboard may only name an output facelib writes: a known suffix, not a hidden
+    file, not the storyboard itself or a file it reads."""
+    if output.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise FdlError(f"output {output.name!r} must end in one of {', '.join(OUTPUT_SUFFIXES)}",
+                       path=path, line=line)
+    if output.name.startswith("."):
+        raise FdlError(f"output {output.name!r} must not be a hidden file", path=path, line=line)
+    if any(source is not None and output == source.resolve() for source in inputs):
+        raise FdlError(f"output {output.name!r} would overwrite one of the storyboard's inputs",
+                       path=path, line=line)
 
 
 def _sub_script(

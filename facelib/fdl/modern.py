@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.context import Context
-from facelib.fdl.suggest import did_you_mean
 from facelib.fdl.timing import parse_time
 from facelib.fdl.values import LuaTable, lua_kind
 from facelib.mpeg4.tables import fap_table

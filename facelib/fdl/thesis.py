@@ -13,9 +13,9 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.context import Context
-from facelib.fdl.suggest import did_you_mean
 from facelib.fdl.timing import frames_to_ms
 from facelib.fdl.values import LuaTable, lua_kind
 

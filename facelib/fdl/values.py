@@ -17,6 +17,8 @@ __all__ = ["LuaTable", "Opaque", "to_python"]
 
 _MAX_DEPTH = 32
 _MAX_NODES = 1_000_000
+MAX_STRING_CHARS = 16 * 1024 * 1024
+"""Characters of strings a script may hand to the host in all (each reference counts)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,17 +59,24 @@ def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> 
     """Copy ``value`` (a lupa value) into plain Python.
 
     ``lines`` is the sandbox's table -> line map. Tables nested deeper than 32 levels
-    (or cyclic), or more than a million values in all, raise FdlError.
+    (or cyclic), more than a million values or more than :data:`MAX_STRING_CHARS` characters
+    of strings in all (a string referenced twice counts twice) raise FdlError.
     """
     from lupa import lua54
 
-    count = [0]
+    count = [0, 0]  # values, string characters
 
     def convert(v: Any, depth: int, where: int | None) -> Any:
         count[0] += 1
         if count[0] > _MAX_NODES:
             raise FdlError(f"script left more than {_MAX_NODES} values", path=path, line=where)
-        if v is None or isinstance(v, bool | int | float | str):
+        if isinstance(v, str):
+            count[1] += len(v)
+            if count[1] > MAX_STRING_CHARS:
+                raise FdlError(f"script left more than {MAX_STRING_CHARS} characters of "
+                               "strings", path=path, line=where)
+            return v
+        if v is None or isinstance(v, bool | int | float):
             return v
         if isinstance(v, bytes):
             raise FdlError("a string is not valid UTF-8", path=path, line=where)
@@ -92,8 +101,8 @@ def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> 
             else:
                 named[key] = convert(item, depth + 1, here)
         n = len(numbered)
-        if numbered and set(numbered) != set(range(1, n + 1)):
-            gaps = sorted(set(range(1, max(numbered) + 1)) - set(numbered))[:3]
+        if numbered and (min(numbered) != 1 or max(numbered) != n):
+            gaps = [i for i in range(1, n + 4) if i not in numbered][:3]
             raise FdlError(
                 f"table has holes in its list part (missing positions {gaps})",
                 path=path,

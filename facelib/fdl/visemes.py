@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
+from facelib.checks import did_you_mean
 from facelib.errors import FdlError, ParameterError
-from facelib.fdl.suggest import did_you_mean
 from facelib.mpeg4.visemes import viseme_aliases
 from facelib.mpeg4.visemes import viseme_id as _viseme_id
 

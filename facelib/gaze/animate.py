@@ -65,7 +65,8 @@ class GazeAnimation:
     @property
     def events(self) -> tuple[Saccade | Blink | HeadMove, ...]:
         """Saccades (including pursuit catch-ups), blinks and head moves by start time."""
-        merged = [*self.saccades, *self.blinks, *self.head_moves]
+        merged: list[Saccade | Blink | HeadMove] = [*self.saccades, *self.blinks,
+                                                    *self.head_moves]
         return tuple(sorted(merged, key=lambda e: e.start))
 
 

@@ -8,15 +8,14 @@ behaviours with plain mappings of the same shape (see ``docs/gaze.md``).
 from __future__ import annotations
 
 import copy
-import difflib
-import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from typing import Any
 
+from facelib import data
+from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.gaze.model import GAZE_MODES, mode_stats
 
@@ -48,26 +47,26 @@ _BEHAVIOUR_KEYS = ("description", "args", "params", "base")
 
 @cache
 def _library_json() -> dict[str, Any]:
-    text = resources.files("facelib.data").joinpath("gaze/behaviours.json").read_text("utf-8")
-    return json.loads(text)
+    library: dict[str, Any] = data.json_data("gaze/behaviours.json")
+    return library
 
 
 def behaviour_library() -> dict[str, dict[str, Any]]:
     """A fresh copy of the built-in behaviours: name -> {description, args, params}."""
-    return {k: copy.deepcopy(v) for k, v in _library_json().items() if not k.startswith("_")}
+    return {k: copy.deepcopy(v) for k, v in _library_json().items()}
 
 
 def _direction_names() -> dict[str, float | None]:
-    return dict(_library_json()["_directions"])
+    return dict(data.json_data("gaze/directions.json")["directions"])
 
 
 DIRECTION_NAMES = tuple(_direction_names())
 
 
 def _suggest(word: str, options: Sequence[str]) -> str:
-    close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
-    if close:
-        return f"; did you mean {close[0]!r}?"
+    hint = did_you_mean(word, options, cutoff=0.5)
+    if hint:
+        return hint
     return f"; expected one of {', '.join(repr(o) for o in options)}"
 
 
@@ -318,19 +317,19 @@ def _blend(
     """Numbers of ``params`` moved a fraction ``t`` of the way from ``defaults``; a None
     (the mode's value) is resolved against ``mode`` first so it can be blended."""
     stats = mode_stats("talking" if mode == "auto" else mode)
-    resolved_none = {
+    resolved_none: dict[str, Any] = {
         "p_mutual": stats.p_mutual,
         "magnitude_max_deg": stats.magnitude_max_deg,
         "direction_percent": list(stats.direction_percent),
     }
     out = dict(params)
     for key in (*_NUMERIC, "direction_percent", *_PAIRS):
-        a = defaults.get(key)
-        b = params.get(key)
+        a: Any = defaults.get(key)
+        b: Any = params.get(key)
         if a == b:
             continue
-        a = resolved_none.get(key) if a is None else a
-        b = resolved_none.get(key) if b is None else b
+        a = resolved_none.get(key, a) if a is None else a
+        b = resolved_none.get(key, b) if b is None else b
         if isinstance(a, list | tuple):
             out[key] = [x + t * (y - x) for x, y in zip(a, b, strict=True)]
         else:

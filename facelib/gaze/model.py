@@ -7,14 +7,14 @@ them once and draws from them with a caller's :class:`numpy.random.Generator`.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from typing import Any
 
 import numpy as np
+
+from facelib import data
 
 __all__ = [
     "GAZE_MODES",
@@ -35,8 +35,8 @@ GAZE_MODES = ("talking", "listening", "thinking")
 @cache
 def gaze_model() -> dict[str, Any]:
     """The parsed ``facelib/data/gaze/model.json`` (treat as read-only)."""
-    text = resources.files("facelib.data").joinpath("gaze/model.json").read_text("utf-8")
-    return json.loads(text)
+    model: dict[str, Any] = data.json_data("gaze/model.json")
+    return model
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,14 +11,14 @@ its FAPU distance; a rotation FAP of 1 is 1e-5 rad (``ANGLE_UNIT``).
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from typing import Literal
 
 import numpy as np
 
+from facelib import data
+from facelib.checks import did_you_mean
 from facelib.errors import ParameterError
 
 __all__ = [
@@ -192,7 +192,8 @@ def fap(key: int | str) -> Fap:
         found = _fap_by_name().get(text.lower())
         if found is not None:
             return found
-        raise ParameterError(f"unknown FAP name {key!r}{_suggest(text.lower(), _fap_by_name())}")
+        hint = did_you_mean(text.lower(), _fap_by_name())
+        raise ParameterError(f"unknown FAP name {key!r}{hint}")
     raise ParameterError(f"a FAP is named by id or name, not {key!r}")
 
 
@@ -201,18 +202,10 @@ def feature_point(key: str) -> FeaturePoint:
     found = feature_point_table().get(str(key).strip())
     if found is None:
         raise ParameterError(
-            f"unknown feature point {key!r}{_suggest(str(key), feature_point_table())}"
+            f"unknown feature point {key!r}{did_you_mean(str(key), feature_point_table())}"
         )
     return found
 
 
-def _suggest(text: str, names: dict[str, object]) -> str:
-    import difflib
-
-    close = difflib.get_close_matches(text, list(names), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
-
-
 def _read_csv(name: str) -> list[dict[str, str]]:
-    with resources.files("facelib.data").joinpath(name).open(encoding="utf-8", newline="") as f:
-        return list(csv.DictReader(f))
+    return [row for _, row in data.csv_rows(name)]

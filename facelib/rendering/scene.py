@@ -14,16 +14,15 @@ background) lives in ``facelib/data/render_look.json``.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from importlib import resources
 from typing import Any, Literal
 
 import numpy as np
 import scipy.sparse as sp
 
+from facelib import data
 from facelib.errors import FaceModelError, ParameterError, RenderError
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
@@ -53,8 +52,7 @@ class Look:
 @lru_cache(maxsize=1)
 def load_look() -> Look:
     """The default :class:`Look` from ``facelib/data/render_look.json``."""
-    text = resources.files("facelib.data").joinpath("render_look.json").read_text("utf-8")
-    raw = json.loads(text)
+    raw = data.json_data("render_look.json")
     return Look(
         parts=raw["parts"],
         lights=tuple(raw["lights"]),
@@ -148,8 +146,8 @@ def normal_operator(n_vertices: int, triangles: np.ndarray) -> sp.csr_matrix:
     triangles = np.asarray(triangles, np.int64)
     rows = triangles.ravel()
     cols = np.repeat(np.arange(len(triangles)), 3)
-    data = np.ones(len(rows), np.float32)
-    return sp.csr_matrix((data, (rows, cols)), shape=(n_vertices, len(triangles)))
+    weights = np.ones(len(rows), np.float32)
+    return sp.csr_matrix((weights, (rows, cols)), shape=(n_vertices, len(triangles)))
 
 
 def vertex_normals(
@@ -249,7 +247,7 @@ def _stabilise_program_cache(pr: Any, offscreen: Any) -> None:
     if inner is None or not isinstance(getattr(inner, "_program_cache", None), base):
         return
 
-    class _OneContextCache(base):
+    class _OneContextCache(base):  # type: ignore[valid-type,misc]  # pyrender is untyped
         def __init__(self, shader_dir: str | None = None):
             super().__init__(shader_dir=shader_dir)
             self._by_source: dict[tuple, Any] = {}
@@ -421,6 +419,7 @@ class FaceRenderer:
     def _upload(self, vertices: np.ndarray, normals: np.ndarray) -> None:
         from OpenGL import GL
 
+        assert self._renderer is not None  # _update only uploads to a live renderer
         self._renderer._platform.make_current()
         for piece, prim, buf in zip(self._pieces, self._primitives, self._interleaved,
                                     strict=True):

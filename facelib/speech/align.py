@@ -12,7 +12,7 @@ plausibility checks then warn or raise naming the word.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from functools import cache
 from pathlib import Path
 from typing import Any, Literal
@@ -173,7 +173,7 @@ def _forced_with(
 
 
 def _shift_boundaries(
-    phones: Sequence[tuple[str, int, int]], settings: dict[str, Any]
+    phones: Sequence[tuple[str, int, int]], settings: Mapping[str, Any]
 ) -> list[tuple[str, int, int]]:
     """The phones ``(label, start_ms, end_ms)`` of one word with the boundary between two
     phones moved by ``boundary_shift_ms["CLASS CLASS"]`` of their ``phone_classes`` (ms,
@@ -194,7 +194,7 @@ def _shift_boundaries(
 def _check_word(
     word: str,
     phones: Sequence[tuple[str, int, int, int]],
-    settings: dict[str, Any],
+    settings: Mapping[str, Any],
     oov: bool,
     *,
     final: bool,
@@ -221,7 +221,7 @@ def _check_word(
 
 
 def _check_pause(
-    words: Sequence[Span], phones: Sequence[tuple[str, int, int, int]], settings: dict[str, Any]
+    words: Sequence[Span], phones: Sequence[tuple[str, int, int, int]], settings: Mapping[str, Any]
 ) -> list[str]:
     """A long pause that scores like speech holds words missing from the transcript."""
     frames = sum(dur for _, _, dur, _ in phones)

@@ -9,19 +9,16 @@ Everything is read once, on first use, and returned as read-only data.
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
-from facelib.errors import FacelibError, ParameterError
+from facelib import data
+from facelib.errors import DataError, ParameterError
 from facelib.mpeg4.tables import N_FAPS, fap
 from facelib.mpeg4.visemes import (
     N_VISEMES,
@@ -47,7 +44,7 @@ __all__ = [
     "viseme_targets",
 ]
 
-_DIR = "data/visemes"
+_DIR = "visemes"
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,37 +67,26 @@ class Dominance:
     theta_after: float
 
 
-def _text(name: str) -> tuple[str, str]:
-    path = resources.files("facelib").joinpath(f"{_DIR}/{name}")
-    return str(path), path.read_text(encoding="utf-8")
-
-
-def _csv_rows(name: str) -> list[tuple[int, dict[str, str]]]:
-    """Rows of a commented CSV as (1-based line number, row dict)."""
-    lines = _text(name)[1].splitlines()
-    kept = [(i + 1, line) for i, line in enumerate(lines) if line and not line.startswith("#")]
-    reader = csv.DictReader(io.StringIO("\n".join(line for _, line in kept)))
-    rows = list(reader)
-    return [(kept[i + 1][0], row) for i, row in enumerate(rows)]
-
-
-def _data_error(name: str, line: int | None, message: str) -> FacelibError:
-    path, _ = _text(name)
-    return FacelibError(message, path=path, line=line)
+def _where(name: str) -> str:
+    return str(data.path(f"{_DIR}/{name}"))
 
 
 @cache
 def _phone_table() -> Mapping[str, PhoneViseme]:
     table: dict[str, PhoneViseme] = {}
-    for line, row in _csv_rows("phone_to_viseme.csv"):
+    for line, row in data.csv_rows(f"{_DIR}/phone_to_viseme.csv"):
         phone = row["phone"]
-        if row["sequence"]:
-            visemes = tuple(int(v) for v in row["sequence"].split(">"))
-            split = float(row["split"])
-        else:
-            visemes, split = (int(row["viseme"]),), 1.0
-        if not all(0 <= v < N_VISEMES for v in visemes) or not 0 < split <= 1:
-            raise _data_error("phone_to_viseme.csv", line, f"bad row for phone {phone!r}")
+        try:
+            if row["sequence"]:
+                visemes = tuple(int(v) for v in row["sequence"].split(">"))
+                split = float(row["split"])
+            else:
+                visemes, split = (int(row["viseme"]),), 1.0
+        except ValueError:
+            visemes, split = (), 0.0
+        if not visemes or not all(0 <= v < N_VISEMES for v in visemes) or not 0 < split <= 1:
+            raise DataError(f"bad row for phone {phone!r}: {row}",
+                            path=_where("phone_to_viseme.csv"), line=line)
         table[phone] = PhoneViseme(phone, visemes, split)
     return MappingProxyType(table)
 
@@ -119,53 +105,53 @@ def phone_viseme(phone: str) -> PhoneViseme:
 @cache
 def viseme_targets() -> np.ndarray:
     """``(15, 84) float32`` FAP values of each viseme at full intensity, in FAP units."""
-    path, text = _text("viseme_faps.json")
-    data = json.loads(text)
+    path = _where("viseme_faps.json")
+    doc = data.json_data(f"{_DIR}/viseme_faps.json")
     targets = np.zeros((N_VISEMES, N_FAPS), np.float32)
     names = viseme_names()
-    if set(data["visemes"]) != set(names):
-        raise FacelibError(f"visemes {sorted(data['visemes'])} differ from {names}", path=path)
+    if set(doc["visemes"]) != set(names):
+        raise DataError(f"visemes {sorted(doc['visemes'])} differ from {names}", path=path)
     for vid, name in enumerate(names):
-        for fap_name, value in data["visemes"][name]["faps"].items():
+        for fap_name, value in doc["visemes"][name]["faps"].items():
             try:
                 targets[vid, fap(fap_name).index] = float(value)
             except ParameterError as exc:
-                raise FacelibError(f"viseme {name!r}: {exc.message}", path=path) from exc
+                raise DataError(f"viseme {name!r}: {exc.message}", path=path) from exc
     targets.flags.writeable = False
     return targets
 
 
 @cache
 def _coarticulation() -> dict[str, Any]:
-    path, text = _text("coarticulation.json")
-    data = json.loads(text)
-    data["_path"] = path
-    return data
+    doc: dict[str, Any] = data.json_data(f"{_DIR}/coarticulation.json")
+    return doc
 
 
 @cache
 def coarticulation_classes() -> Mapping[str, tuple[int, ...]]:
     """FAP class name -> 0-based FAP columns (jaw, lip_height, lip_shape, tongue). Together
     they are the FAPs the viseme track drives."""
-    data = _coarticulation()
+    doc = _coarticulation()
+    path = _where("coarticulation.json")
     out: dict[str, tuple[int, ...]] = {}
-    for cls, members in data["classes"].items():
+    for cls, members in doc["classes"].items():
         try:
             out[cls] = tuple(fap(m).index for m in members)
         except ParameterError as exc:
-            raise FacelibError(f"class {cls!r}: {exc.message}", path=data["_path"]) from exc
+            raise DataError(f"class {cls!r}: {exc.message}", path=path) from exc
     return MappingProxyType(out)
 
 
 @cache
 def dominance_table() -> Mapping[tuple[int, str], Dominance]:
     """(viseme id, FAP class) -> :class:`Dominance`, defaults filled in."""
-    data = _coarticulation()
-    default = data["default"]
+    doc = _coarticulation()
+    path = _where("coarticulation.json")
+    default = doc["default"]
     out: dict[tuple[int, str], Dominance] = {}
     for vid, name in enumerate(viseme_names()):
-        rules = data["visemes"].get(name, {})
-        for cls in data["classes"]:
+        rules = doc["visemes"].get(name, {})
+        for cls in doc["classes"]:
             params = {**default, **rules.get("*", {}), **rules.get(cls, {})}
             dom = Dominance(
                 float(params["alpha"]),
@@ -173,7 +159,7 @@ def dominance_table() -> Mapping[tuple[int, str], Dominance]:
                 float(params["theta_after"]),
             )
             if dom.alpha <= 0 or dom.theta_before <= 0 or dom.theta_after <= 0:
-                raise FacelibError(f"non-positive dominance for {name}/{cls}", path=data["_path"])
+                raise DataError(f"non-positive dominance for {name}/{cls}", path=path)
             out[vid, cls] = dom
     return MappingProxyType(out)
 
