@@ -99,32 +99,40 @@ def _surface_distances(setup: RegionSetup, nodes: np.ndarray, sources: np.ndarra
 def feature_point_weights(setup: RegionSetup) -> np.ndarray:
     """Kshirsagar's geometric interpolation (eq. 2.1-2.4) over surface distances.
 
-    Each vertex P is influenced by its nearest source FP1 (zone growth over the surface) and
-    the two neighbours FP2, FP3 of FP1 (sources whose zones touch) with the smallest angle at
-    FP1 between FP1->P and FP1->FPj, both below pi/2. Each influence i has its own reach
-    ``d_bar_i`` (eq. 2.3: the cosine-weighted mean of its surface distances to its chosen
-    neighbours), weight ``W_i`` (eq. 2.1) and ``M[P, i] = (W_i / d_i^2) / sum_j (W_j /
-    d_j^2)`` (eq. 2.4); at ``d_i = 0`` the row is ``e_i``. Returns (Vr, S) over all sources.
+    Zones grow over the surface from every source; sources whose zones touch are neighbours.
+    Seen from a vertex P, source i has the reach ``d_bar_i`` of eq. 2.3: the cosine-weighted
+    mean of its surface distances to the two neighbours at the smallest angles (at i,
+    between i->P and i->j) below pi/2. Its weight is ``W_i`` of eq. 2.1 and ``M[P, i] = (W_i /
+    d_i^2) / sum_j (W_j / d_j^2)`` (eq. 2.4); at ``d_i = 0`` the row is ``e_i``.
+
+    ``influences`` (a parameter) picks the sources that act on P: ``"zones"`` (default,
+    Kshirsagar's original) every source whose reach covers P; ``"nearest"`` (the seed's
+    implementation, section 3.3) P's nearest source and that source's two chosen neighbours.
+    Returns (Vr, S) over all sources; a vertex beyond every reach follows its nearest source.
     """
+    mode = setup.params.get("influences", "zones")
+    if mode not in ("zones", "nearest"):
+        raise setup.fail(f"feature_point influences must be 'zones' or 'nearest', got {mode!r}")
     sources = np.concatenate([setup.controls, setup.anchors])
     nodes = np.unique(np.concatenate([setup.members, sources]))
     dist = _surface_distances(setup, nodes, sources)  # (S, n)
     local = np.searchsorted(nodes, setup.members)
-    pos = setup.vertices
     zone = dist.argmin(axis=0)  # nearest source of every node
     neighbours = _zone_neighbours(setup, nodes, zone, sources.size)
     d_src = dist[:, np.searchsorted(nodes, sources)]  # (S, S) surface distances
-    members = pos[setup.members]
-    src = pos[sources]
+    members = setup.vertices[setup.members]
+    src = setup.vertices[sources]
     out = np.zeros((setup.members.size, sources.size))
     for row, (p, node) in enumerate(zip(members, local, strict=True)):
         first = int(zone[node])
-        chosen = _pick(p, first, neighbours[first], src)
-        influences = [first, *chosen]
-        d = dist[influences, node]
-        if d[0] == 0.0:
+        if dist[first, node] == 0.0:
             out[row, first] = 1.0
             continue
+        if mode == "nearest":
+            influences = np.array([first, *_pick(p, first, neighbours[first], src)])
+        else:
+            influences = np.flatnonzero(np.isfinite(dist[:, node]))
+        d = dist[influences, node]
         reach = np.array([_reach(p, i, neighbours[i], src, d_src) for i in influences])
         w = kshirsagar_weight(d, reach) / d**2
         if not np.isfinite(w).all() or w.sum() <= 0:
@@ -232,7 +240,8 @@ DEFORMERS = (
         "Point Distance: normalised 1/(1 + d^p) weights of the sources (not interpolating)",
         "second seed eq. 3.4 with eq. 2.5-2.6", interpolating=False),
     Deformer(
-        "feature_point", lambda s: _controls_only(feature_point_weights(s), s), {},
+        "feature_point", lambda s: _controls_only(feature_point_weights(s), s),
+        {"influences": "zones"},
         "Kshirsagar's geometric interpolation over surface distances",
         "second seed eq. 2.1-2.4"),
     Deformer(
