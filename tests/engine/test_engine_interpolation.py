@@ -179,7 +179,7 @@ def test_t8_rbf_defaults_reproduce_the_thesis_multiquadric() -> None:
     assert np.array_equal(today, new)
 
 
-@pytest.mark.parametrize("kernel", ["multiquadric_eck", "thin_plate_spline", "gaussian",
+@pytest.mark.parametrize("kernel", ["multiquadric_eck", "wendland", "thin_plate_spline", "gaussian",
                                     "cubic", "inverse_multiquadric"])
 def test_t8_rbf_polynomial_reproduces_translation_and_affine_maps(kernel: str) -> None:
     rng = np.random.default_rng(5)
