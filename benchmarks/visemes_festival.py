@@ -2,7 +2,7 @@
 aligner): the ``festival`` Debian package with the ``festvox-us-slt-hts`` voice.
 
 Not part of the library: used by ``benchmarks/visemes_align_accuracy.py`` and
-``tests/visemes/make_fixtures.py``.
+``tests/data/speech/make_fixtures.py``.
 """
 
 from __future__ import annotations

@@ -18,15 +18,19 @@ from facelib import expressions, fdl, gaze, mpeg4, sync, visemes
 from facelib.animation import Animation, animate, run_fdl
 from facelib.engine import Face, load_face
 from facelib.errors import (
+    DataError,
     FacelibError,
     FacelibWarning,
     FaceModelError,
     FapFormatError,
     FdlError,
+    FdlWarning,
+    FileError,
     MissingExtraError,
     ParameterError,
     RenderError,
     SpeechError,
+    SpeechWarning,
 )
 from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
 
@@ -52,6 +56,7 @@ def __getattr__(name: str) -> Any:
 
 __all__ = [
     "Animation",
+    "DataError",
     "Face",
     "FaceModelError",
     "FacelibError",
@@ -60,10 +65,13 @@ __all__ = [
     "FapStream",
     "FapTrack",
     "FdlError",
+    "FdlWarning",
+    "FileError",
     "MissingExtraError",
     "ParameterError",
     "RenderError",
     "SpeechError",
+    "SpeechWarning",
     "__version__",
     "animate",
     "expressions",

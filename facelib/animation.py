@@ -8,17 +8,20 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
 
 import numpy as np
 
 from facelib import expressions, gaze, visemes
+from facelib.checks import check_seed
 from facelib.cues import MAX_FRAMES, Storyboard
 from facelib.errors import ParameterError
 from facelib.fdl import load
+from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.sync import SyncRules, combine
+from facelib.visemes.animate import VisemeAnimation
+from facelib.visemes.timeline import VisemeSpan
 
 __all__ = ["Animation", "animate", "run_fdl"]
 
@@ -42,8 +45,8 @@ class Animation:
     storyboard: Storyboard
     audio_offset: float = 0.0
     tracks: Mapping[str, FapTrack] = field(default_factory=dict)
-    visemes: Any = None
-    gaze_events: Any = ()
+    visemes: tuple[VisemeSpan, ...] | None = None
+    gaze_events: tuple[GazeEvent, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "tracks", MappingProxyType(dict(self.tracks)))
@@ -63,7 +66,7 @@ def animate(
     anything is computed.
     """
     if seed is not None:
-        storyboard = replace(storyboard, seed=int(seed))
+        storyboard = replace(storyboard, seed=check_seed(seed))
     rules = rules or SyncRules.load()
     fps = storyboard.fps
     # one frame past the last cue's end, so the face is shown settling back to neutral
@@ -105,10 +108,10 @@ def animate(
     )
 
 
-def _with_importance(speech: Any, rules: SyncRules) -> FapTrack:
+def _with_importance(speech: VisemeAnimation, rules: SyncRules) -> FapTrack:
     """The viseme track with each viseme's importance (``rules.viseme_importance``) on its
     weight, frame by frame along the timeline."""
-    track: FapTrack = speech.track
+    track = speech.track
     if not rules.viseme_importance:
         return track
     factor = np.ones(track.n_frames, np.float32)

@@ -16,7 +16,7 @@ import numpy as np
 
 from facelib.errors import ParameterError
 
-__all__ = ["check_count", "check_fps", "check_number", "did_you_mean"]
+__all__ = ["check_count", "check_fps", "check_number", "check_seed", "did_you_mean"]
 
 
 def check_number(name: str, value: object, *, low: float | None = None,
@@ -53,6 +53,16 @@ def check_count(name: str, value: object, *, low: int = 0) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
         raise ParameterError(f"{name} must be an integer >= {low}, got {value!r}")
     return int(value)
+
+
+def check_seed(seed: object) -> int:
+    """``seed`` as an int in ``[0, 2**63)`` (what numpy's SeedSequence and the FDL accept);
+    ``ParameterError`` for bools, floats, negatives and anything else."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not (
+        0 <= seed < 2**63
+    ):
+        raise ParameterError(f"seed must be an integer from 0 to 2^63-1, got {seed!r}")
+    return int(seed)
 
 
 def did_you_mean(word: str, choices: Iterable[str], *, cutoff: float = 0.7) -> str:

@@ -8,11 +8,14 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import facelib
 from facelib.errors import FacelibError
-from facelib.mpeg4 import FapStream, fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4 import DIALECTS, FapStream, fap, read_fap, read_fap_file, write_fap
+
+if TYPE_CHECKING:
+    from facelib.animation import Animation
 
 __all__ = ["main"]
 
@@ -50,7 +53,7 @@ def _check(args: argparse.Namespace) -> int:
     return 0
 
 
-def _animation(path: str, seed: int | None) -> Any:
+def _animation(path: str, seed: int | None) -> Animation | FapStream:
     """A storyboard's Animation, or a .fap file's stream."""
     if Path(path).suffix.lower() == ".fap":
         return read_fap(path)
@@ -242,8 +245,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("story", help="the .fdl storyboard")
     run.add_argument("-o", "--output", help="the .fap file (default: the storyboard's output)")
     run.add_argument("--seed", type=int, help="seed of the random processes")
-    run.add_argument("--dialect", default="standard",
-                     choices=("standard", "xface", "greta", "extended"))
+    run.add_argument("--dialect", default="standard", choices=DIALECTS)
     run.set_defaults(run=_run)
 
     render = commands.add_parser("render", help="render a storyboard (or .fap) to video")
@@ -272,6 +274,13 @@ def _build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--seed", type=int)
     plot.set_defaults(run=_plot)
 
+    _add_align_command(commands)
+    _add_evaluate_command(commands)
+    _add_track_command(commands)
+    return parser
+
+
+def _add_align_command(commands: Any) -> None:
     align = commands.add_parser("align", help="align speech audio to visemes")
     align.add_argument("audio", help="speech audio (any format soundfile reads)")
     align.add_argument("--text", help="the transcript (omit for phone-loop recognition)")
@@ -280,6 +289,8 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.set_defaults(run=_align)
 
+
+def _add_evaluate_command(commands: Any) -> None:
     evaluate = commands.add_parser(
         "evaluate", help="compare deformers by lip roughness (CSV, Markdown, contact sheet)")
     evaluate.add_argument("-o", "--output", required=True, help="folder for the results")
@@ -291,8 +302,6 @@ def _build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--stem", default="deformers", help="file name stem")
     evaluate.add_argument("--no-sheet", action="store_true", help="skip the mouth contact sheet")
     evaluate.set_defaults(run=_evaluate)
-    _add_track_command(commands)
-    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -16,6 +16,8 @@ __all__ = [
     "FacelibWarning",
     "FapFormatError",
     "FdlError",
+    "FdlWarning",
+    "FileError",
     "MissingExtraError",
     "ParameterError",
     "RenderError",
@@ -83,6 +85,16 @@ class RenderError(FacelibError):
 class TrackingError(FacelibError):
     """A video or landmark track cannot be turned into FAPs (no face, unreadable video,
     wrong point count, missing feature points); the message names the frames."""
+class FileError(FacelibError, OSError):
+    """A file or folder could not be read or written: the operating system's error
+    (``OSError``, kept as ``__cause__``) with the path it concerns."""
+
+    @classmethod
+    def wrap(cls, exc: OSError, what: str, path: str | Path) -> FileError:
+        """``FileError`` for ``exc`` raised while doing ``what`` ("write", "read") at
+        ``path``."""
+        reason = exc.strerror or str(exc)
+        return cls(f"cannot {what}: {reason}", path=path)
 
 
 class MissingExtraError(FacelibError, ImportError):
@@ -97,6 +109,11 @@ class MissingExtraError(FacelibError, ImportError):
 
 class FacelibWarning(UserWarning):
     """Something was accepted but looked irregular (e.g. frames missing from a ``.fap``)."""
+
+
+class FdlWarning(FacelibWarning):
+    """A storyboard ran but something in it looks like a mistake (a global that is no
+    setting but close to one, ``fsp = 30``), named with its file and line."""
 
 
 class SpeechWarning(FacelibWarning):

@@ -6,34 +6,42 @@ Needs matplotlib (the ``plot`` extra); it is imported on first use.
 from __future__ import annotations
 
 import os
+import textwrap
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from facelib.atomic import atomic_path
 from facelib.errors import MissingExtraError
 from facelib.mpeg4.stream import FapStream
-from facelib.mpeg4.tables import fap
+from facelib.mpeg4.tables import fap, fap_groups, fap_table
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from facelib.animation import Animation
+    from facelib.cues import Storyboard
 
 __all__ = ["REGIONS", "plot_curves"]
 
-REGIONS: tuple[tuple[str, tuple[int, ...]], ...] = (
-    ("jaw and inner lips", tuple(range(3, 19))),
-    ("outer lips", tuple(range(51, 61))),
-    ("extended lips and nose", tuple(range(69, 85))),
-    ("eyelids (IRISD)", (19, 20, 21, 22)),
-    ("eyeballs (AU)", tuple(range(23, 31))),
-    ("eyebrows", tuple(range(31, 39))),
-    ("cheeks, nose, ears", (*range(39, 43), *range(61, 69))),
-    ("tongue", tuple(range(43, 48))),
-    ("head (AU)", (48, 49, 50)),
-)
-"""Panels: a title and the FAP ids it shows."""
+def _regions() -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """One panel per FAP group of the standard (``fap_groups``) that moves the face: group
+    1 (visemes and expressions) is expanded into the others."""
+    groups = fap_groups()
+    return tuple(
+        (name, tuple(f.id for f in fap_table() if f.group == group))
+        for group, name in groups.items()
+        if group != 1
+    )
+
+
+REGIONS: tuple[tuple[str, tuple[int, ...]], ...] = _regions()
+"""Panels: a title (the FAP group's name) and the FAP ids it shows."""
 
 
 def plot_curves(
-    source: FapStream | Any,
+    source: FapStream | Animation,
     out: str | os.PathLike[str],
     *,
     title: str | None = None,
@@ -67,7 +75,7 @@ def plot_curves(
         for f in faps:
             info = fap(f)
             ax.plot(t, stream.values[:, f - 1], lw=1.1, label=f"{f} {info.name} ({info.fapu})")
-        ax.set_ylabel(name, fontsize=8)
+        ax.set_ylabel(textwrap.fill(name, 24), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
         if faps:
@@ -82,16 +90,14 @@ def plot_curves(
     return Path(out)
 
 
-def _shade_cues(ax: Any, storyboard: Any) -> None:
-    colours = {"expression": "tab:orange", "gaze": "tab:blue"}
-    for kind, cues in (("expression", storyboard.expressions), ("gaze", storyboard.gaze)):
-        for cue in cues:
-            start, end = cue.start_ms / 1000, cue.end_ms / 1000
-            ax.axvspan(start, end, color=colours[kind], alpha=0.07, lw=0)
-            label = cue.name if kind == "expression" else cue.behaviour
-            y = 0.95 if kind == "expression" else 0.05
-            ax.text(start, y, label, transform=ax.get_xaxis_transform(), fontsize=6,
-                    color=colours[kind], va="top" if y > 0.5 else "bottom")
+def _shade_cues(ax: Axes, storyboard: Storyboard) -> None:
+    labelled = [("tab:orange", 0.95, c.start_ms, c.end_ms, c.name) for c in storyboard.expressions]
+    labelled += [("tab:blue", 0.05, c.start_ms, c.end_ms, c.behaviour) for c in storyboard.gaze]
+    for colour, y, start_ms, end_ms, label in labelled:
+        start, end = start_ms / 1000, end_ms / 1000
+        ax.axvspan(start, end, color=colour, alpha=0.07, lw=0)
+        ax.text(start, y, label, transform=ax.get_xaxis_transform(), fontsize=6,
+                color=colour, va="top" if y > 0.5 else "bottom")
     speech = storyboard.speech
     if speech is not None and speech.visemes:
         ax.axvspan(speech.visemes[0].start_ms / 1000, speech.visemes[-1].end_ms / 1000,

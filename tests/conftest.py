@@ -1,12 +1,19 @@
-"""Fixtures shared by the whole suite."""
+"""Fixtures shared by the whole test tree: a seeded random generator and the builders that
+tests used to re-declare per file (FAP frames and streams, the default head), and a memory
+cap for hostile-input tests."""
 
 from __future__ import annotations
 
 import resource
-from collections.abc import Iterator
+import zlib
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from facelib.mpeg4.stream import FapStream
+from facelib.mpeg4.tables import N_FAPS, fap
 
 HOSTILE_HEADROOM = 1536 * 1024 * 1024
 """Address space a hostile-input test may add to the process (1.5 GiB)."""
@@ -36,3 +43,59 @@ def memory_cap() -> Iterator[None]:
         yield
     finally:
         resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
+
+FapFrame = Callable[..., np.ndarray]
+FapStreamBuilder = Callable[..., FapStream]
+
+
+@pytest.fixture
+def rng(request: pytest.FixtureRequest) -> np.random.Generator:
+    """A generator seeded from the test's id: the same draws on every run of that test,
+    different draws in different tests."""
+    return np.random.default_rng(zlib.crc32(request.node.nodeid.encode("utf-8")))
+
+
+def _column(key: str) -> int:
+    """``"open_jaw"`` or ``"f3"`` (FAP 3) -> 0-based column."""
+    if key[:1] == "f" and key[1:].isdigit():
+        return fap(int(key[1:])).index
+    return fap(key).index
+
+
+def build_frame(**values: float) -> np.ndarray:
+    """``(84,) float32`` FAP values, zero but for the FAPs named (``open_jaw=300``) or
+    numbered (``f3=300``)."""
+    out = np.zeros(N_FAPS, np.float32)
+    for key, value in values.items():
+        out[_column(key)] = value
+    return out
+
+
+def build_stream(n_frames: int, *, fps: float = 25.0, **columns: object) -> FapStream:
+    """A FapStream of ``n_frames`` with the named FAPs set to a value or an ``(n_frames,)``
+    array each (FAPs 3-68 masked in, as FapStream's default)."""
+    values = np.zeros((n_frames, N_FAPS), np.float32)
+    for key, column in columns.items():
+        values[:, _column(key)] = np.asarray(column, dtype=np.float32)
+    return FapStream(fps, values)
+
+
+@pytest.fixture
+def fap_frame() -> FapFrame:
+    """The :func:`build_frame` builder."""
+    return build_frame
+
+
+@pytest.fixture
+def fap_stream() -> FapStreamBuilder:
+    """The :func:`build_stream` builder."""
+    return build_stream
+
+
+@pytest.fixture(scope="session")
+def default_face():  # -> facelib.engine.Face
+    """The default head, loaded once per session."""
+    from facelib.engine import load_face
+
+    return load_face()

@@ -15,7 +15,7 @@ import soundfile
 
 from facelib import fdl
 from facelib.atomic import atomic_path, write_text_atomic
-from facelib.errors import FdlError, ParameterError
+from facelib.errors import FdlError, FileError, ParameterError
 from facelib.mpeg4 import FapStream, write_fap
 
 
@@ -65,7 +65,7 @@ def test_outputs_never_replace_special_files(tmp_path, kind):
         target.mkdir()
     else:
         target = ""
-    with pytest.raises(ParameterError, match=r"will not replace|empty"):
+    with pytest.raises(FileError, match=r"will not replace|empty"):
         write_fap(stream, target)
     assert Path("/dev/null").exists() and not Path("/dev/null").is_file()
     if kind == "symlink":
@@ -73,14 +73,14 @@ def test_outputs_never_replace_special_files(tmp_path, kind):
         assert (tmp_path / "real.fap").read_text() == "keep"
 
 
-def test_unwritable_folder_is_a_parameter_error(tmp_path):
+def test_unwritable_folder_is_a_file_error(tmp_path):
     if os.geteuid() == 0:
         target = "/proc/facelib/out.fap"  # cannot be created even by root
     else:
         locked = tmp_path / "locked"
         locked.mkdir(mode=0o500)
         target = locked / "out.fap"
-    with pytest.raises(ParameterError, match="cannot write"):
+    with pytest.raises(FileError, match="cannot write"):
         write_text_atomic(target, "x")
 
 

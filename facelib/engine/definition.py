@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
+from facelib import data
 from facelib.engine.face import PART_NAMES, RIGID_DEFORMERS, Face, Region
 from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
 from facelib.errors import FaceModelError, ParameterError
@@ -39,7 +39,7 @@ def required_feature_points() -> tuple[str, ...]:
 
 
 def _default_path() -> Path:
-    return Path(str(resources.files("facelib.data").joinpath("head", "default_head.json")))
+    return Path(str(data.path("head/default_head.json")))
 
 
 def default_face() -> Face:
@@ -222,57 +222,62 @@ class _Reader:
             raise self.fail(f"neck normal {raw['normal']!r} and blend {blend!r} must be nonzero")
         return point, normal / length, blend
 
-    def regions(self, nv: int, fps: dict[str, int], pivots: dict[str, np.ndarray]) -> tuple:
+    def regions(
+        self, nv: int, points: dict[str, int], pivots: dict[str, np.ndarray]
+    ) -> tuple[Region, ...]:
         raw = self.get("regions", list)
-        out, names = [], set()
+        out: list[Region] = []
+        names: set[str] = set()
         for i, item in enumerate(raw):
-            where = f"regions[{i}]"
             if not isinstance(item, dict) or not isinstance(item.get("name"), str):
-                raise self.fail(f"{where} must be an object with a name")
-            name = item["name"]
-            where = f"region {name!r}"
-            if name in names:
-                raise self.fail(f"{where} is defined twice")
-            names.add(name)
-            group = item.get("group", "")
-            if not isinstance(group, str):
-                raise self.fail(f"{where} group must be a string, not {group!r}")
-            deformer_name, custom, params = self.deformer_of(item, name, group, where)
-            controls = item.get("feature_points")
-            if not isinstance(controls, list) or not controls:
-                raise self.fail(f"{where} needs a non-empty list of feature_points")
-            for c in controls:
-                if c not in fps:
-                    raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
-            vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
-            anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors",
-                                   allow_empty=True)
-            weights = np.zeros(0, np.float32)
-            pivot = ""
-            deformer_name = ALIASES.get(deformer_name, deformer_name)
-            deformer = deformer_name
-            if deformer == "rbf" and len(controls) + anchors.size < 2:
-                raise self.fail(f"{where}: an RBF needs at least two sources")
-            if deformer in ("weights", "eyelid"):
-                if len(controls) != 1:
-                    raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
-                weights = np.asarray(item.get("weights", []), dtype=np.float64)
-                if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
-                    raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
-            if deformer == "eyelid":
-                pivot = str(item.get("pivot"))
-                if pivot not in pivots:
-                    raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
-            out.append(Region(name=name, deformer=deformer, feature_points=tuple(controls),
-                              vertices=vertices, anchors=anchors,
-                              weights=weights.astype(np.float32), pivot=pivot,
-                              params=MappingProxyType(params), group=group, custom=custom))
+                raise self.fail(f"regions[{i}] must be an object with a name")
+            if item["name"] in names:
+                raise self.fail(f"region {item['name']!r} is defined twice")
+            names.add(item["name"])
+            out.append(self.region(item, nv, points, pivots))
         unused = sorted(set(self.overrides) - names - {r.group for r in out})
         if unused:
             known = sorted(names | {r.group for r in out if r.group})
             raise ParameterError(f"deformers override {unused[0]!r} names no region or group "
                                  f"of {self.path.name} (known: {', '.join(known)})")
         return tuple(out)
+
+    def region(self, item: dict, nv: int, points: dict[str, int],
+               pivots: dict[str, np.ndarray]) -> Region:
+        """One region of the definition, validated, with its deformer resolved."""
+        name = item["name"]
+        where = f"region {name!r}"
+        group = item.get("group", "")
+        if not isinstance(group, str):
+            raise self.fail(f"{where} group must be a string, not {group!r}")
+        deformer_name, custom, params = self.deformer_of(item, name, group, where)
+        controls = item.get("feature_points")
+        if not isinstance(controls, list) or not controls:
+            raise self.fail(f"{where} needs a non-empty list of feature_points")
+        for c in controls:
+            if c not in points:
+                raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
+        vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
+        anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors",
+                               allow_empty=True)
+        deformer = ALIASES.get(deformer_name, deformer_name)
+        if deformer == "rbf" and len(controls) + anchors.size < 2:
+            raise self.fail(f"{where}: an RBF needs at least two sources")
+        weights = np.zeros(0, np.float32)
+        if deformer in ("weights", "eyelid"):
+            if len(controls) != 1:
+                raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
+            weights = np.asarray(item.get("weights", []), dtype=np.float64)
+            if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
+                raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
+        pivot = ""
+        if deformer == "eyelid":
+            pivot = str(item.get("pivot"))
+            if pivot not in pivots:
+                raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
+        return Region(name=name, deformer=deformer, feature_points=tuple(controls),
+                      vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
+                      pivot=pivot, params=MappingProxyType(params), group=group, custom=custom)
 
     def deformer_of(self, item: dict, name: str, group: str, where: str
                     ) -> tuple[str, Deformer | None, dict[str, Any]]:

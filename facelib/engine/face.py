@@ -207,12 +207,7 @@ class Face:
         tris = _readonly(triangles, np.int32)
         fps = MappingProxyType(dict(feature_points))
         fapu = MappingProxyType(compute_fapu(verts, fps))
-        part_map = {}
-        for name, part_ids in parts.items():
-            ids = _readonly(part_ids, np.int32)
-            inside = np.zeros(len(verts), bool)
-            inside[ids] = True
-            part_map[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+        part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
         operator, steps = _compile(verts, tris, fps, fapu, regions)
         for region in regions:
@@ -224,32 +219,8 @@ class Face:
                     )
         columns = np.unique(operator.indices).astype(np.int64)
         dense = operator[:, columns].toarray().astype(np.float32)
-        head = pivot_map["head"]
-        point, normal, blend = neck
-        height = (verts.astype(np.float64) - point) @ normal
-        t = np.clip(height / blend, 0.0, 1.0)
-        head_w = t * t * (3 - 2 * t)
-        jaw_ids = np.concatenate(
-            [part_map["teeth_lower"].vertex_ids, part_map["tongue"].vertex_ids])
-        rigid_parts = _Rigid(
-            lids=_lids(verts, fps, fapu, regions, pivot_map),
-            eyes=tuple(
-                (_columns(part_map[name].vertex_ids),
-                 (verts[part_map[name].vertex_ids] - pivot_map[name]).astype(np.float32),
-                 np.tile(pivot_map[name].astype(np.float32), part_map[name].vertex_ids.size),
-                 yaw, pitch, thrust)
-                for name, yaw, pitch, thrust in _EYES
-            ),
-            jaw_x=_columns(jaw_ids, "x"),
-            jaw_y=_columns(jaw_ids, "y"),
-            jaw_z=_columns(jaw_ids, "z"),
-            jaw_pivot=pivot_map["jaw"],
-            chin=verts[fps["2.1"]].astype(np.float64),
-            head_pivot=head,
-            head_tiled=np.tile(head.astype(np.float32), len(verts)),
-            head_weights=head_w[head_w < 1.0].astype(np.float32),
-            neck=_columns(np.nonzero(head_w < 1.0)[0]),
-        )
+        rigid_parts = _rigid(verts, fps, fapu, regions=regions, parts=part_map,
+                             pivots=pivot_map, neck=neck)
         return cls(
             vertices=verts,
             triangles=tris,
@@ -496,3 +467,48 @@ def _lids(
     centres = np.array([pivots[name] for name in pivot_of], np.float32).reshape(-1, 3)
     return _Lids(tuple(hinges), _columns(ids, "y"), _columns(ids, "z"), centres[:, 1],
                  centres[:, 2], weights)
+
+
+def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
+           ) -> dict[str, Part]:
+    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it."""
+    out = {}
+    for name, part_ids in parts.items():
+        ids = _readonly(part_ids, np.int32)
+        inside = np.zeros(n_vertices, bool)
+        inside[ids] = True
+        out[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+    return out
+
+
+def _rigid(verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float], *,
+           regions: tuple[Region, ...], parts: Mapping[str, Part],
+           pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float]
+           ) -> _Rigid:
+    """The rigid steps' precomputed columns, offsets and weights (eyes, lids, jaw, head)."""
+    head = pivots["head"]
+    point, normal, blend = neck
+    height = (verts.astype(np.float64) - point) @ normal
+    t = np.clip(height / blend, 0.0, 1.0)
+    head_w = t * t * (3 - 2 * t)
+    jaw_ids = np.concatenate(
+        [parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
+    return _Rigid(
+        lids=_lids(verts, fps, fapu, regions, pivots),
+        eyes=tuple(
+            (_columns(parts[name].vertex_ids),
+             (verts[parts[name].vertex_ids] - pivots[name]).astype(np.float32),
+             np.tile(pivots[name].astype(np.float32), parts[name].vertex_ids.size),
+             yaw, pitch, thrust)
+            for name, yaw, pitch, thrust in _EYES
+        ),
+        jaw_x=_columns(jaw_ids, "x"),
+        jaw_y=_columns(jaw_ids, "y"),
+        jaw_z=_columns(jaw_ids, "z"),
+        jaw_pivot=pivots["jaw"],
+        chin=verts[fps["2.1"]].astype(np.float64),
+        head_pivot=head,
+        head_tiled=np.tile(head.astype(np.float32), len(verts)),
+        head_weights=head_w[head_w < 1.0].astype(np.float32),
+        neck=_columns(np.nonzero(head_w < 1.0)[0]),
+    )

@@ -3,21 +3,20 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from functools import cache
 from typing import Literal
 
 import numpy as np
 
+from facelib import data
 from facelib.checks import check_count, check_fps
 from facelib.cues import ExpressionCue
-from facelib.errors import FdlError, ParameterError
+from facelib.errors import DataError, FdlError, ParameterError
 from facelib.expressions.library import ExpressionLibrary, default_library
 from facelib.mpeg4.tables import N_FAPS
 from facelib.mpeg4.track import FapTrack
 
-__all__ = ["DEFAULT_RAMP_MS", "animate", "envelope"]
-
-DEFAULT_RAMP_MS = 400
-"""Default ramp in and out, capped at a quarter of the cue's duration."""
+__all__ = ["animate", "default_ramp_ms", "envelope"]
 
 Easing = Literal["linear", "smooth"]
 
@@ -50,8 +49,25 @@ def envelope(
     return s
 
 
+@cache
+def _ramp_rules() -> tuple[int, float]:
+    doc = data.json_data("expression_ramps.json")
+    try:
+        return int(doc["ramp_ms"]), float(doc["max_fraction"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DataError(f"bad ramp rules: {exc!r}",
+                        path=str(data.path("expression_ramps.json"))) from exc
+
+
+def default_ramp_ms(duration_ms: int) -> int:
+    """Ramp in and out (ms) of a cue of ``duration_ms`` that gives none:
+    ``expression_ramps.json``'s ``ramp_ms``, capped at its ``max_fraction`` of the cue."""
+    ramp_ms, fraction = _ramp_rules()
+    return min(ramp_ms, int(duration_ms * fraction))
+
+
 def _ramps(cue: ExpressionCue) -> tuple[int, int]:
-    default = min(DEFAULT_RAMP_MS, cue.duration_ms // 4)
+    default = default_ramp_ms(cue.duration_ms)
     ramp_in = default if cue.ramp_in_ms is None else cue.ramp_in_ms
     ramp_out = default if cue.ramp_out_ms is None else cue.ramp_out_ms
     if ramp_in < 0 or ramp_out < 0 or ramp_in + ramp_out > cue.duration_ms:

@@ -6,6 +6,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from facelib.cues import Origin
+
 __all__ = ["Context", "line_of_name"]
 
 
@@ -22,6 +24,10 @@ class Context:
     def line_of(self, name: str, *, after: int | None = None) -> int | None:
         """Line where ``name = ...`` is first written (at or after line ``after``)."""
         return line_of_name(self.source, name, after=after)
+
+    def origin(self, line: int | None) -> Origin | None:
+        """The cue origin ``(path, line)`` of line ``line`` of this script (None without)."""
+        return None if line is None else (self.path, int(line))
 
 
 def line_of_name(source: str, name: str, *, after: int | None = None) -> int | None:

@@ -79,6 +79,33 @@ def _skip_long_bracket(src: str, i: int, level: str) -> int:
     return len(src) if end < 0 else end + len(close)
 
 
+def _token(source: str, i: int) -> tuple[int, str]:
+    """End index and kind of the token starting at ``source[i]``.
+
+    Kinds: ``"space"`` (whitespace, one character), ``"comment"``, ``"string"`` (short or
+    long), ``"kw"`` (a Lua keyword), ``"name"``, ``"number"``, ``"{"``, ``"}"``, ``")"``,
+    ``"]"`` or ``"op"`` (any other single character).
+    """
+    c = source[i]
+    if c.isspace():
+        return i + 1, "space"
+    if source.startswith("--", i):
+        m = _LONG_OPEN.match(source, i + 2)
+        end = _skip_long_bracket(source, m.end(), m.group(1)) if m else source.find("\n", i)
+        return (len(source) if end < 0 else end), "comment"
+    if c in "\"'":
+        return _skip_short_string(source, i), "string"
+    if c == "[" and (m := _LONG_OPEN.match(source, i)):
+        return _skip_long_bracket(source, m.end(), m.group(1)), "string"
+    if m := _NAME.match(source, i):
+        return m.end(), "kw" if m.group() in _KEYWORDS else "name"
+    if (c.isdigit() or (c == "." and source[i + 1 : i + 2].isdigit())) and (
+        m := _NUMBER.match(source, i)
+    ):
+        return m.end(), "number"
+    return i + 1, c if c in "{})]" else "op"
+
+
 def mark_tables(source: str) -> str:
     """Return ``source`` with every table constructor wrapped in ``__fdl_at(line, ...)``.
 
@@ -89,70 +116,20 @@ def mark_tables(source: str) -> str:
     closers: list[str] = []  # what each open brace becomes when it closes
     line = 1
     i = 0
-    n = len(source)
-    prev = ""  # kind of the previous significant token: "name", "kw", "string", ")", ...
-    while i < n:
-        c = source[i]
-        if c == "\n":
-            line += 1
-            out.append(c)
-            i += 1
-            continue
-        if c.isspace():
-            out.append(c)
-            i += 1
-            continue
-        if source.startswith("--", i):
-            m = _LONG_OPEN.match(source, i + 2)
-            end = _skip_long_bracket(source, m.end(), m.group(1)) if m else source.find("\n", i)
-            end = n if end < 0 else end
-            chunk = source[i:end]
-            line += chunk.count("\n")
-            out.append(chunk)
-            i = end
-            continue
-        if c in "\"'":
-            end = _skip_short_string(source, i)
-        elif c == "[" and (m := _LONG_OPEN.match(source, i)):
-            end = _skip_long_bracket(source, m.end(), m.group(1))
-        else:
-            end = -1
-        if end >= 0:
-            chunk = source[i:end]
-            line += chunk.count("\n")
-            out.append(chunk)
-            i = end
-            prev = "string"
-            continue
-        if m := _NAME.match(source, i):
-            word = m.group()
-            out.append(word)
-            i = m.end()
-            prev = "kw" if word in _KEYWORDS else "name"
-            continue
-        if (c.isdigit() or (c == "." and i + 1 < n and source[i + 1].isdigit())) and (
-            m := _NUMBER.match(source, i)
-        ):
-            out.append(m.group())
-            i = m.end()
-            prev = "number"
-            continue
-        if c == "{":
-            if prev in ("name", "string", ")", "]", "}"):
-                out.append(f"({AT_NAME}({line},{{")
-                closers.append("}))")
-            else:
-                out.append(f"{AT_NAME}({line},{{")
-                closers.append("})")
-            prev = "{"
-            i += 1
-            continue
-        if c == "}":
+    prev = ""  # kind of the previous significant token (see _token)
+    while i < len(source):
+        end, kind = _token(source, i)
+        text = source[i:end]
+        if kind == "{":
+            call_argument = prev in ("name", "string", ")", "]", "}")
+            out.append(f"({AT_NAME}({line},{{" if call_argument else f"{AT_NAME}({line},{{")
+            closers.append("}))" if call_argument else "})")
+        elif kind == "}":
             out.append(closers.pop() if closers else "}")
-            prev = "}"
-            i += 1
-            continue
-        out.append(c)
-        prev = c if c in ")]" else "op"
-        i += 1
+        else:
+            out.append(text)
+        line += text.count("\n")
+        if kind not in ("space", "comment"):
+            prev = kind
+        i = end
     return "".join(out)

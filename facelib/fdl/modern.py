@@ -1,10 +1,10 @@
-"""The modern FDL syntax: storyboard functions a writer calls (see ``docs/fdl.md``).
+"""The readers of the modern FDL syntax's storyboard functions (see ``docs/fdl.md``).
 
 ``say``, ``show``, ``look``, ``define_expression`` and ``define_gaze`` each take one table
-(``say`` also a plain string). The sandbox records the calls with their lines; this module
-validates them and turns them into timed cues. Times are seconds or unit strings (see
-:mod:`facelib.fdl.timing`); a cue without ``at`` starts where the previous cue of its kind
-ended.
+(``say`` also a plain string); they are declared in :mod:`facelib.fdl.functions`, which
+dispatches each call the sandbox recorded to its reader here. A reader validates the call
+into draft cues; :mod:`facelib.fdl.modern_cues` times the drafts into cues. Times are
+seconds or unit strings (see :mod:`facelib.fdl.timing`).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from facelib.checks import did_you_mean
 from facelib.errors import FdlError
@@ -22,14 +22,20 @@ from facelib.fdl.timing import parse_time
 from facelib.fdl.values import LuaTable, lua_kind
 from facelib.mpeg4.tables import fap_table
 
-__all__ = ["FUNCTIONS", "DraftCue", "DraftSpeech", "ModernParts", "read_calls"]
+if TYPE_CHECKING:
+    from facelib.fdl.functions import StoryboardFunction
 
-FUNCTIONS = ("say", "show", "look", "define_expression", "define_gaze")
-"""The storyboard functions of the modern syntax."""
+__all__ = [
+    "DraftCue",
+    "DraftSpeech",
+    "ModernParts",
+    "read_define_expression",
+    "read_define_gaze",
+    "read_look",
+    "read_say",
+    "read_show",
+]
 
-_SHOW_FIELDS = ("at", "dur", "intensity", "ease_in", "ease_out")
-_LOOK_FIELDS = ("at", "dur")
-_SAY_FIELDS = ("text", "transcript", "audio", "visemes", "at")
 _MAX_FAP_VALUE = 100_000.0
 
 
@@ -71,30 +77,11 @@ class ModernParts:
     gaze_defs: dict[str, Mapping[str, Any]] = field(default_factory=dict)
 
 
-def read_calls(calls: list[tuple[str, Any, int | None, int]], ctx: Context) -> ModernParts:
-    """Validate recorded calls ``(function, argument, line, n_arguments)`` into parts."""
-    parts = ModernParts()
-    readers = {
-        "say": _say,
-        "show": _show,
-        "look": _look,
-        "define_expression": _define_expression,
-        "define_gaze": _define_gaze,
-    }
-    for name, arg, line, n_args in calls:
-        if n_args != 1:
-            raise FdlError(
-                f"{name} takes one table, like {name} {{ ... }}; got {n_args} arguments",
-                path=ctx.path,
-                line=line,
-            )
-        readers[name](arg, ctx, line, parts)
-    return parts
-
-
 def _table(
-    arg: object, fn: str, ctx: Context, line: int | None, *, allowed: tuple[str, ...]
+    arg: object, fn: str, ctx: Context, line: int | None, *, allowed: tuple[str, ...] | None
 ) -> LuaTable:
+    """``arg`` as a table; FdlError if it is not one or has a field outside ``allowed``
+    (None: any field)."""
     if not isinstance(arg, LuaTable):
         raise FdlError(
             f'{fn} takes a table, like {fn} {{ "name", ... }}; got a {lua_kind(arg)} {arg!r}',
@@ -102,7 +89,7 @@ def _table(
             line=line,
         )
     for key in arg.fields:
-        if key not in allowed:
+        if allowed is not None and key not in allowed:
             raise FdlError(
                 f"{fn}: unknown field {key!r}{did_you_mean(key, allowed)}"
                 f" (fields: {', '.join(allowed)})",
@@ -142,8 +129,11 @@ def _opt_time(
     return None if key not in fields else _time(fields[key], f"{fn}: {key}", ctx, line)
 
 
-def _show(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    t = _table(arg, "show", ctx, line, allowed=_SHOW_FIELDS)
+def read_show(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``show { "name", dur = ..., at, intensity, ease_in, ease_out }``: an expression."""
+    t = _table(arg, "show", ctx, line, allowed=fn.fields)
     name = _name(t, "show", ctx, line, named="times and intensity (at = ..., dur = ...)")
     if "dur" not in t.fields:
         raise FdlError(f"show {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
@@ -182,8 +172,11 @@ def _show(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> No
     )
 
 
-def _look(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    t = _table(arg, "look", ctx, line, allowed=_LOOK_FIELDS)
+def read_look(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``look { "behaviour", args..., dur = ..., at }``: an eye behaviour."""
+    t = _table(arg, "look", ctx, line, allowed=fn.fields)
     name = _name(t, "look", ctx, line)
     if "dur" not in t.fields:
         raise FdlError(f"look {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
@@ -207,7 +200,10 @@ def _look(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> No
     )
 
 
-def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
+def read_say(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``say "text"`` or ``say { "text" or transcript/audio/visemes, at }``: the speech."""
     if parts.speech is not None:
         raise FdlError(
             f"say is called a second time (the first call is on line {parts.speech.line}); "
@@ -218,7 +214,7 @@ def _say(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> Non
     if isinstance(arg, str):
         parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
         return
-    t = _table(arg, "say", ctx, line, allowed=_SAY_FIELDS)
+    t = _table(arg, "say", ctx, line, allowed=fn.fields)
     f = t.fields
     if len(t.items) > 1 or (t.items and not isinstance(t.items[0], str)):
         raise FdlError(
@@ -280,10 +276,11 @@ def _visemes(
     return tuple(out)
 
 
-def _define_expression(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    if not isinstance(arg, LuaTable):
-        _table(arg, "define_expression", ctx, line, allowed=())
-    t: LuaTable = arg  # type: ignore[assignment]
+def read_define_expression(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``define_expression { "name", FAP = value..., mix = {...} }``."""
+    t = _table(arg, "define_expression", ctx, line, allowed=fn.fields)
     name = _name(t, "define_expression", ctx, line,
                  named="FAP values (raise_l_cornerlip_o = 120)")
     valid = {f.name: f for f in fap_table() if f.kind != "special"}
@@ -362,10 +359,11 @@ def _mix(value: object, name: str, ctx: Context, line: int | None) -> dict[str, 
     return out
 
 
-def _define_gaze(arg: object, ctx: Context, line: int | None, parts: ModernParts) -> None:
-    if not isinstance(arg, LuaTable):
-        _table(arg, "define_gaze", ctx, line, allowed=())
-    t: LuaTable = arg  # type: ignore[assignment]
+def read_define_gaze(
+    arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
+) -> None:
+    """``define_gaze { "name", parameter = value... }``: an eye behaviour."""
+    t = _table(arg, "define_gaze", ctx, line, allowed=fn.fields)
     name = _name(t, "define_gaze", ctx, line, named="parameters (rate = 2.0)")
     params: dict[str, Any] = {}
     for key, value in t.fields.items():

@@ -183,7 +183,8 @@ class Sandbox:
             _, env, lines, calls, used = result
             return ChunkResult(path=path, env=env, lines=lines, calls=calls, instructions=used)
         _, kind, message, line, _used = result
-        raise _error(kind, str(message), line, path=path, short=short, limits=self)
+        raise _error(kind, str(message), line, path=path, short=short, limits=self,
+                     functions=functions)
 
     def _restart(self) -> None:
         self._start()
@@ -210,8 +211,11 @@ _GLOBAL = re.compile(r"\((?:global|field) '([A-Za-z_][A-Za-z0-9_]*)'\)")
 
 
 def _error(
-    kind: str, message: str, line: int, *, path: str, short: str, limits: Sandbox
+    kind: str, message: str, line: int, *, path: str, short: str, limits: Sandbox,
+    functions: tuple[str, ...],
 ) -> FdlError:
+    """The FdlError for a failed chunk; a call of an unknown global suggests the closest
+    whitelisted name or storyboard function (``functions``, those the chunk was given)."""
     where = None if line is None or line < 1 else int(line)
     if kind == "instructions":
         return FdlError(
@@ -247,10 +251,6 @@ def _error(
         return FdlError(f"syntax error: {message}", path=path, line=where)
     g = _GLOBAL.search(message)
     if g and ("call" in message or "index" in message):
-        message += did_you_mean(g.group(1), (*WHITELIST, *_STORYBOARD_FUNCTIONS))
+        message += did_you_mean(g.group(1), (*WHITELIST, *functions))
     return FdlError(message, path=path, line=where)
 
-
-_STORYBOARD_FUNCTIONS: tuple[str, ...] = (
-    "say", "show", "look", "define_expression", "define_gaze",
-)  # fmt: skip

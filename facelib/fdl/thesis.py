@@ -111,53 +111,50 @@ def sequence(
     frame = 0.0
     for index, entry in enumerate(table.items, start=1):
         where = entry.line if isinstance(entry, LuaTable) and entry.line else table.line or line
-        label = f"{list_name}[{index}]"
-        if not isinstance(entry, LuaTable) or entry.fields:
-            raise FdlError(
-                f'{label} must be a list like {{"name", ..., frames}}; got {_show(entry)}',
-                path=ctx.path,
-                line=where,
-            )
-        values = entry.items
-        if len(values) < min_len or (max_len is not None and len(values) > max_len):
-            expected = str(min_len) if max_len == min_len else f"at least {min_len}"
-            raise FdlError(
-                f"{label} has {len(values)} values; expected {expected} (name, ..., frames)",
-                path=ctx.path,
-                line=where,
-            )
-        name, *args, frames = values
-        if not isinstance(name, str) or not name:
-            raise FdlError(
-                f"{label} must start with a name; got {name!r}", path=ctx.path, line=where
-            )
-        if (
-            isinstance(frames, bool)
-            or not isinstance(frames, int | float)
-            or not (0 <= frames < 1e7)
-        ):
-            raise FdlError(
-                f"{label} ends with {frames!r}; expected a duration in frames (a number >= 0)",
-                path=ctx.path,
-                line=where,
-            )
-        for arg in args:
-            if isinstance(arg, bool) or not isinstance(arg, str | int | float):
-                raise FdlError(
-                    f"{label} value {arg!r} must be a string or a number",
-                    path=ctx.path,
-                    line=where,
-                )
+        name, args, frames = _entry(entry, f"{list_name}[{index}]", ctx, where,
+                                    min_len=min_len, max_len=max_len)
         start = frames_to_ms(frame, ctx.fps)
-        frame += float(frames)
+        frame += frames
         end = frames_to_ms(frame, ctx.fps)
-        yield SequenceEntry(
-            name=name,
-            args=tuple(a if isinstance(a, str) else float(a) for a in args),
-            start_ms=start,
-            duration_ms=end - start,
+        yield SequenceEntry(name=name, args=args, start_ms=start, duration_ms=end - start,
+                            line=where)
+
+
+def _entry(
+    entry: object, label: str, ctx: Context, where: int | None, *, min_len: int,
+    max_len: int | None,
+) -> tuple[str, tuple[str | float, ...], float]:
+    """One entry ``{name, ..., frames}`` of a thesis list as (name, values between, frames);
+    FdlError naming ``label`` (``eyes[2]``) at line ``where`` if it is malformed."""
+    if not isinstance(entry, LuaTable) or entry.fields:
+        raise FdlError(
+            f'{label} must be a list like {{"name", ..., frames}}; got {_show(entry)}',
+            path=ctx.path,
             line=where,
         )
+    values = entry.items
+    if len(values) < min_len or (max_len is not None and len(values) > max_len):
+        expected = str(min_len) if max_len == min_len else f"at least {min_len}"
+        raise FdlError(
+            f"{label} has {len(values)} values; expected {expected} (name, ..., frames)",
+            path=ctx.path,
+            line=where,
+        )
+    name, *args, frames = values
+    if not isinstance(name, str) or not name:
+        raise FdlError(f"{label} must start with a name; got {name!r}", path=ctx.path, line=where)
+    if isinstance(frames, bool) or not isinstance(frames, int | float) or not 0 <= frames < 1e7:
+        raise FdlError(
+            f"{label} ends with {frames!r}; expected a duration in frames (a number >= 0)",
+            path=ctx.path,
+            line=where,
+        )
+    for arg in args:
+        if isinstance(arg, bool) or not isinstance(arg, str | int | float):
+            raise FdlError(
+                f"{label} value {arg!r} must be a string or a number", path=ctx.path, line=where
+            )
+    return name, tuple(a if isinstance(a, str) else float(a) for a in args), float(frames)
 
 
 def _show(value: object) -> str:

@@ -7,13 +7,14 @@ log; ``simulate`` runs one behaviour for checking; ``pursue`` follows a moving t
 
 from facelib.gaze.animate import GAZE_FAPS, GazeAnimation, animate, pursue, simulate
 from facelib.gaze.behaviours import BoundBehaviour, behaviour_library, bind_behaviour
-from facelib.gaze.events import Blink, HeadMove, Saccade
+from facelib.gaze.events import Blink, GazeEvent, HeadMove, Saccade
 
 __all__ = [
     "GAZE_FAPS",
     "Blink",
     "BoundBehaviour",
     "GazeAnimation",
+    "GazeEvent",
     "HeadMove",
     "Saccade",
     "animate",

@@ -12,25 +12,31 @@ from typing import Any
 
 import numpy as np
 
-from facelib.checks import check_fps
+from facelib.checks import check_count, check_fps, check_number, check_seed
 from facelib.cues import GazeCue
 from facelib.errors import ParameterError
 from facelib.gaze.behaviours import BoundBehaviour, bind_behaviour, merge_behaviours
 from facelib.gaze.blinks import blink_closure, schedule_blinks
-from facelib.gaze.events import Blink, HeadMove, Saccade
+from facelib.gaze.events import Blink, GazeEvent, HeadMove, Saccade
 from facelib.gaze.model import gaze_model
 from facelib.gaze.motion import Motion
 from facelib.gaze.planner import Planner
-from facelib.mpeg4.tables import ANGLE_UNIT, N_FAPS
+from facelib.mpeg4.tables import ANGLE_UNIT, N_FAPS, fap
 from facelib.mpeg4.track import FapTrack
 
 __all__ = ["GAZE_FAPS", "GazeAnimation", "animate", "pursue", "simulate"]
 
-GAZE_FAPS = (19, 20, 21, 22, 23, 24, 25, 26, 48, 49, 50)
-"""The FAPs the eye generator drives."""
+# The FAPs the eye generator drives, by their names in the standard's table.
+_UPPER_LIDS = ("close_t_l_eyelid", "close_t_r_eyelid")
+_LOWER_LIDS = ("close_b_l_eyelid", "close_b_r_eyelid")
+_YAW = ("yaw_l_eyeball", "yaw_r_eyeball")
+_PITCH = ("pitch_l_eyeball", "pitch_r_eyeball")
+_HEAD = ("head_pitch", "head_yaw", "head_roll")
+
+GAZE_FAPS = tuple(fap(name).id for name in (*_UPPER_LIDS, *_LOWER_LIDS, *_YAW, *_PITCH, *_HEAD))
+"""The FAPs the eye generator drives (ids 19-26 and 48-50)."""
 
 _DEG_AU = float(np.pi / 180.0 / ANGLE_UNIT)  # 1 degree in angle units (1745.33 AU)
-_HEAD_WEIGHT_FULL_DEG = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,17 +69,16 @@ class GazeAnimation:
     blink_lids: tuple[float, float]
 
     @property
-    def events(self) -> tuple[Saccade | Blink | HeadMove, ...]:
+    def events(self) -> tuple[GazeEvent, ...]:
         """Saccades (including pursuit catch-ups), blinks and head moves by start time."""
-        merged: list[Saccade | Blink | HeadMove] = [*self.saccades, *self.blinks,
-                                                    *self.head_moves]
+        merged: list[GazeEvent] = [*self.saccades, *self.blinks, *self.head_moves]
         return tuple(sorted(merged, key=lambda e: e.start))
 
 
-def _check_frames(fps: float, n_frames: int) -> None:
-    check_fps(fps)
-    if not isinstance(n_frames, (int, np.integer)) or n_frames < 0:
-        raise ParameterError(f"n_frames must be an integer >= 0, got {n_frames!r}")
+def _checked(fps: object, n_frames: object, seed: object) -> tuple[float, int, int]:
+    """The shared argument checks: ``ParameterError`` for a bad frame rate, frame count or
+    seed."""
+    return check_fps(fps), check_count("n_frames", n_frames), check_seed(seed)
 
 
 def _mode_lookup(speaking: np.ndarray | None, fps: float, n_frames: int):
@@ -117,7 +122,7 @@ def animate(
     FdlError: unknown behaviour (with a suggestion) or bad values, with the cue's file/line.
     ParameterError: bad fps, n_frames or speaking.
     """
-    _check_frames(fps, n_frames)
+    fps, n_frames, seed = _checked(fps, n_frames, seed)
     library = merge_behaviours(behaviours)
     bound = [
         (c, bind_behaviour(c.behaviour, c.args, library=library, origin=c.origin))
@@ -128,6 +133,24 @@ def animate(
     gaze_rng, blink_rng = np.random.default_rng(seed).spawn(2)
     planner = Planner(gaze_rng, _mode_lookup(speaking, fps, n_frames))
 
+    segments = _segments(bound, default, seconds)
+    for t0, t1, behaviour in segments:
+        if t0 >= seconds:
+            break
+        engine = getattr(planner, behaviour.engine)
+        engine(t0, min(t1, seconds), behaviour)
+
+    blinks = schedule_blinks(
+        blink_rng, seconds=seconds, rate_per_min=planner.blink_rate, evoked_at=planner.evoked
+    )
+    return _render(planner, blinks, fps=fps, n_frames=n_frames, vergence=None)
+
+
+def _segments(
+    bound: Sequence[tuple[GazeCue, BoundBehaviour]], default: BoundBehaviour, seconds: float
+) -> list[tuple[float, float, BoundBehaviour]]:
+    """(start s, end s, behaviour) runs covering ``[0, seconds]``: each cue until the next
+    cue starts, the default behaviour in the gaps and after the last cue."""
     segments: list[tuple[float, float, BoundBehaviour]] = []
     t = 0.0
     for k, (cue, behaviour) in enumerate(bound):
@@ -142,16 +165,22 @@ def animate(
         t = max(t, end)
     if t < seconds or not segments:
         segments.append((t, max(seconds, t), default))
-    for t0, t1, behaviour in segments:
-        if t0 >= seconds:
-            break
-        engine = getattr(planner, behaviour.engine)
-        engine(t0, min(t1, seconds), behaviour)
+    return segments
 
-    blinks = schedule_blinks(
-        blink_rng, seconds=seconds, rate_per_min=planner.blink_rate, evoked_at=planner.evoked
-    )
-    return _render(planner, blinks, fps=fps, n_frames=n_frames, vergence=None)
+
+def _columns(names: Sequence[str]) -> list[int]:
+    """0-based columns of the named FAPs in a frame of 84 values."""
+    return [fap(name).index for name in names]
+
+
+def _open_lids(aperture: np.ndarray, pitch_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Upper and lower lid values (IRISD units, ``(n,)``) without blinks: the behaviour's
+    ``aperture`` (closure fraction) and the lid-eye coupling to the eyes' ``pitch_deg``."""
+    lids = gaze_model()["lids"]
+    closed = gaze_model()["blink"]["upper_closure_irisd"]
+    upper = aperture * closed - lids["upper_irisd_per_deg"] * pitch_deg
+    upper_open = np.clip(upper, lids["upper_min_irisd"], lids["upper_max_irisd"])
+    return upper_open, lids["lower_irisd_per_deg"] * pitch_deg
 
 
 def _render(
@@ -168,31 +197,31 @@ def _render(
     head = planner.head.sample(times)
     eyes = np.clip(gaze - head, planner.eye_lo, planner.eye_hi)
     closure = blink_closure(times, blinks, frame_s=1.0 / fps)
-    aperture = planner.lid.sample(times)[:, 0]
-    lids = model["lids"]
     b = model["blink"]
-    upper = aperture * b["upper_closure_irisd"] - lids["upper_irisd_per_deg"] * eyes[:, 1]
-    upper_open = np.clip(upper, lids["upper_min_irisd"], lids["upper_max_irisd"])
+    upper_open, lower_open = _open_lids(planner.lid.sample(times)[:, 0], eyes[:, 1])
     upper = upper_open + (b["upper_closure_irisd"] - upper_open) * closure
-    lower_open = lids["lower_irisd_per_deg"] * eyes[:, 1]
     lower = lower_open + (b["lower_closure_irisd"] - lower_open) * closure
     half_v = np.zeros(n_frames) if vergence is None else 0.5 * vergence
 
     values = np.zeros((n_frames, N_FAPS), dtype=np.float64)
     weight = np.zeros((n_frames, N_FAPS), dtype=np.float32)
-    values[:, 18] = values[:, 19] = upper
-    values[:, 20] = values[:, 21] = lower
-    values[:, 22] = (eyes[:, 0] - half_v) * _DEG_AU
-    values[:, 23] = (eyes[:, 0] + half_v) * _DEG_AU
-    values[:, 24] = values[:, 25] = -eyes[:, 1] * _DEG_AU
-    values[:, 47] = -head[:, 1] * _DEG_AU
-    values[:, 48] = head[:, 0] * _DEG_AU
-    weight[:, 18:26] = 1.0
-    head_w = np.clip(np.hypot(head[:, 0], head[:, 1]) / _HEAD_WEIGHT_FULL_DEG, 0.0, 1.0)
-    weight[:, 47:50] = head_w[:, None]
+    upper_lids, lower_lids = _columns(_UPPER_LIDS), _columns(_LOWER_LIDS)
+    (yaw_l, yaw_r), pitch = _columns(_YAW), _columns(_PITCH)
+    head_pitch, head_yaw, _roll = head_cols = _columns(_HEAD)
+    values[:, upper_lids] = upper[:, None]
+    values[:, lower_lids] = lower[:, None]
+    values[:, yaw_l] = (eyes[:, 0] - half_v) * _DEG_AU
+    values[:, yaw_r] = (eyes[:, 0] + half_v) * _DEG_AU
+    values[:, pitch] = (-eyes[:, 1] * _DEG_AU)[:, None]
+    values[:, head_pitch] = -head[:, 1] * _DEG_AU
+    values[:, head_yaw] = head[:, 0] * _DEG_AU
+    weight[:, [*upper_lids, *lower_lids, yaw_l, yaw_r, *pitch]] = 1.0
+    full = float(model["head"]["weight_full_deg"])
+    head_w = np.clip(np.hypot(head[:, 0], head[:, 1]) / full, 0.0, 1.0)
+    weight[:, head_cols] = head_w[:, None]
     track = FapTrack(fps, values.astype(np.float32), weight)
-    values[:, 18] = values[:, 19] = upper_open
-    values[:, 20] = values[:, 21] = lower_open
+    values[:, upper_lids] = upper_open[:, None]
+    values[:, lower_lids] = lower_open[:, None]
     open_track = FapTrack(fps, values.astype(np.float32), weight)
     arrays = []
     for array in (gaze, eyes, head, closure):
@@ -225,8 +254,8 @@ def simulate(
     """Run one behaviour for ``seconds`` as an eye-script tuple would, e.g.
     ``simulate("default", "talking", 0.9, seconds=600)``. ``speaking`` says whether the
     character talks throughout (for mode ``auto``)."""
-    if not (isinstance(seconds, (int, float)) and np.isfinite(seconds) and seconds > 0):
-        raise ParameterError(f"seconds must be a positive number, got {seconds!r}")
+    seconds = check_number("seconds", seconds, low=0.0, low_open=True)
+    fps = check_fps(fps)
     n_frames = round(seconds * fps)
     cue = GazeCue(behaviour, tuple(args), 0, round(seconds * 1000))
     talk = np.full(n_frames, bool(speaking))
@@ -260,8 +289,7 @@ def pursue(
     target = np.asarray(target_deg, dtype=float)
     if target.ndim != 2 or target.shape[1] != 2 or not np.isfinite(target).all():
         raise ParameterError(f"target_deg must be a finite (n_frames, 2) array, got {target.shape}")
-    n_frames = target.shape[0]
-    _check_frames(fps, n_frames)
+    fps, n_frames, seed = _checked(fps, target.shape[0], seed)
     planner = Planner(np.random.default_rng(seed).spawn(2)[0], lambda t: "listening")
     if start_deg != (0.0, 0.0):
         planner.gaze = Motion(start_deg)

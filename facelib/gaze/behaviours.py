@@ -110,46 +110,10 @@ def merge_behaviours(
 
 
 def _validate(name: str, spec: Mapping[str, Any]) -> None:
+    """FdlError naming behaviour ``name`` for any malformed parameter or argument."""
     params = spec.get("params", {})
     for key, value in params.items():
-        if key not in PARAM_KEYS:
-            raise FdlError(
-                f"eye behaviour {name!r}: unknown parameter {key!r}" + _suggest(key, PARAM_KEYS)
-            )
-        if key in _NUMERIC and value is not None:
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-                raise FdlError(
-                    f"eye behaviour {name!r}: {key} must be a number >= 0, got {value!r}"
-                )
-            if key == "p_mutual" and value > 1:
-                raise FdlError(f"eye behaviour {name!r}: p_mutual must be <= 1, got {value!r}")
-    if params.get("engine", "statistical") not in ENGINES:
-        raise FdlError(
-            f"eye behaviour {name!r}: engine {params['engine']!r}"
-            + _suggest(str(params["engine"]), ENGINES)
-        )
-    if "mode" in params and params["mode"] not in (*GAZE_MODES, "auto"):
-        raise FdlError(
-            f"eye behaviour {name!r}: mode {params['mode']!r}"
-            + _suggest(str(params["mode"]), (*GAZE_MODES, "auto"))
-        )
-    percent = params.get("direction_percent")
-    if percent is not None and (
-        len(percent) != 8
-        or any(not isinstance(p, (int, float)) or p < 0 for p in percent)
-        or sum(percent) <= 0
-    ):
-        raise FdlError(
-            f"eye behaviour {name!r}: direction_percent must be 8 numbers >= 0, got {percent!r}"
-        )
-    for key in _PAIRS:
-        pair = params.get(key)
-        if pair is not None and (
-            len(pair) != 2 or not all(isinstance(v, (int, float)) for v in pair)
-        ):
-            raise FdlError(
-                f"eye behaviour {name!r}: {key} must be [left, up] degrees, got {pair!r}"
-            )
+        _validate_param(name, key, value)
     for arg in spec.get("args", []):
         if arg.get("kind") not in ARG_KINDS:
             raise FdlError(
@@ -161,6 +125,32 @@ def _validate(name: str, spec: Mapping[str, Any]) -> None:
                 f"eye behaviour {name!r}: argument sets {arg.get('sets')!r}"
                 + _suggest(str(arg.get("sets")), (*PARAM_KEYS, *_SLOTS))
             )
+
+
+def _validate_param(name: str, key: str, value: Any) -> None:
+    """FdlError unless ``value`` is valid for parameter ``key`` of behaviour ``name``."""
+    where = f"eye behaviour {name!r}"
+    if key not in PARAM_KEYS:
+        raise FdlError(f"{where}: unknown parameter {key!r}" + _suggest(key, PARAM_KEYS))
+    if value is None and key not in ("engine", "mode"):
+        return  # None: the mode's own value
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if key in _NUMERIC and (not number or not math.isfinite(value) or value < 0):
+        raise FdlError(f"{where}: {key} must be a number >= 0, got {value!r}")
+    if key == "p_mutual" and value > 1:
+        raise FdlError(f"{where}: p_mutual must be <= 1, got {value!r}")
+    if key == "engine" and value not in ENGINES:
+        raise FdlError(f"{where}: engine {value!r}" + _suggest(str(value), ENGINES))
+    if key == "mode" and value not in (*GAZE_MODES, "auto"):
+        raise FdlError(f"{where}: mode {value!r}" + _suggest(str(value), (*GAZE_MODES, "auto")))
+    if key == "direction_percent" and (
+        len(value) != 8
+        or any(not isinstance(p, (int, float)) or p < 0 for p in value)
+        or sum(value) <= 0
+    ):
+        raise FdlError(f"{where}: direction_percent must be 8 numbers >= 0, got {value!r}")
+    if key in _PAIRS and (len(value) != 2 or not all(isinstance(v, (int, float)) for v in value)):
+        raise FdlError(f"{where}: {key} must be [left, up] degrees, got {value!r}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -259,11 +249,15 @@ def bind_behaviour(
     slots: dict[str, Any] = {}
     for i, arg in enumerate(arg_specs):
         value = args[i] if i < len(args) else arg.get("default")
-        if value is None:
-            slots[arg["sets"]] = None
-            continue
-        slots[arg["sets"]] = _bind_arg(name, arg, value, where)
+        slots[arg["sets"]] = None if value is None else _bind_arg(name, arg, value, where)
+    return _bound(name, _params(library, spec, slots), slots)
 
+
+def _params(
+    library: Mapping[str, Mapping[str, Any]], spec: Mapping[str, Any], slots: Mapping[str, Any]
+) -> dict[str, Any]:
+    """The behaviour's parameters over the default behaviour's, with the script's values
+    (``slots``) set and the rest blended toward the default by ``slots["intensity"]``."""
     defaults = dict(library["default"]["params"])
     params = {**defaults, **spec.get("params", {})}
     for key in PARAM_KEYS:
@@ -272,14 +266,21 @@ def bind_behaviour(
     if "p_away" in slots:
         params["p_mutual"] = 1.0 - slots["p_away"]
     intensity = float(slots.get("intensity", 1.0))
-    mode = params["mode"]
     if intensity != 1.0:
-        blended = _blend(defaults, params, intensity, mode)
+        blended = _blend(defaults, params, intensity, params["mode"])
         # Values given directly by the script are not scaled by the intensity.
         direct = {k for k in PARAM_KEYS if k in slots} | (
             {"p_mutual"} if "p_away" in slots else set()
         )
         params = {k: params[k] if k in direct else blended[k] for k in params}
+    return params
+
+
+def _optional_float(value: Any) -> float | None:
+    return None if value is None else float(value)
+
+
+def _bound(name: str, params: Mapping[str, Any], slots: Mapping[str, Any]) -> BoundBehaviour:
     direction = slots.get("direction")
     angle = float(slots.get("angle", 0.0) or 0.0)
     if direction is None:
@@ -287,21 +288,19 @@ def bind_behaviour(
     else:
         rad = math.radians(direction)
         target = (angle * math.cos(rad), angle * math.sin(rad))
+    percent = params["direction_percent"]
+    gaze_offset, head_offset = params["gaze_offset_deg"], params["head_offset_deg"]
     return BoundBehaviour(
         name=name,
         engine=params.get("engine", "statistical"),
-        mode=mode,
-        direction_percent=None
-        if params["direction_percent"] is None
-        else tuple(map(float, params["direction_percent"])),
+        mode=params["mode"],
+        direction_percent=None if percent is None else tuple(map(float, percent)),
         magnitude_scale=float(params["magnitude_scale"]),
-        magnitude_max_deg=None
-        if params["magnitude_max_deg"] is None
-        else float(params["magnitude_max_deg"]),
-        p_mutual=None if params["p_mutual"] is None else float(params["p_mutual"]),
+        magnitude_max_deg=_optional_float(params["magnitude_max_deg"]),
+        p_mutual=_optional_float(params["p_mutual"]),
         interval_scale=max(float(params["interval_scale"]), 1e-3),
-        gaze_offset_deg=(float(params["gaze_offset_deg"][0]), float(params["gaze_offset_deg"][1])),
-        head_offset_deg=(float(params["head_offset_deg"][0]), float(params["head_offset_deg"][1])),
+        gaze_offset_deg=(float(gaze_offset[0]), float(gaze_offset[1])),
+        head_offset_deg=(float(head_offset[0]), float(head_offset[1])),
         lid_closure=float(params["lid_closure"]),
         blink_scale=float(params["blink_scale"]),
         head_coupling=float(params["head_coupling"]),

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-__all__ = ["Blink", "HeadMove", "Saccade", "SaccadeKind"]
+__all__ = ["Blink", "GazeEvent", "HeadMove", "Saccade", "SaccadeKind"]
 
 SaccadeKind = Literal["mutual", "away", "look", "catch_up"]
 
@@ -56,3 +56,7 @@ class HeadMove:
     duration: float
     magnitude: float
     direction: float
+
+
+GazeEvent = Saccade | Blink | HeadMove
+"""One logged event of the eye generator."""

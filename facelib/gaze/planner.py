@@ -25,8 +25,6 @@ from facelib.gaze.pursuit import pursue_path
 
 __all__ = ["Planner"]
 
-_LID_RAMP_S = 0.3
-
 
 def _polar(vec: np.ndarray) -> tuple[float, float]:
     """(magnitude, direction in [0, 360)) of a (left, up) vector in degrees."""
@@ -35,9 +33,13 @@ def _polar(vec: np.ndarray) -> tuple[float, float]:
 
 def head_move_duration(amplitude_deg: float) -> float:
     """Seconds for a head rotation of ``amplitude_deg``: minimum-jerk movement whose peak
-    velocity 1.875 A / T equals Greta's (4/3 A/50 + 2/5) * 50 deg/s."""
-    peak = (4.0 / 3.0 * amplitude_deg / 50.0 + 0.4) * 50.0
-    return max(1.875 * amplitude_deg / peak, 0.1)
+    velocity 1.875 A / T equals Greta's (4/3 A/50 + 2/5) * 50 deg/s (``model.json``
+    ``head``)."""
+    head = gaze_model()["head"]
+    peak = float(head["peak_velocity_per_deg"]) * amplitude_deg + float(
+        head["peak_velocity_base_deg_s"])
+    duration = float(head["minjerk_peak_factor"]) * amplitude_deg / peak
+    return max(duration, float(head["min_duration_s"]))
 
 
 class Planner:
@@ -124,7 +126,8 @@ class Planner:
     def begin(self, t: float, behaviour: BoundBehaviour, *, blink_scale: float = 1.0) -> None:
         """Start a segment: lid aperture ramps to the behaviour's, blink rate follows it."""
         if behaviour.lid_closure != self._lid_value:
-            self.lid.add(Movement(t, _LID_RAMP_S, (behaviour.lid_closure, 0.0), "minjerk"))
+            ramp = float(gaze_model()["lids"]["aperture_ramp_s"])
+            self.lid.add(Movement(t, ramp, (behaviour.lid_closure, 0.0), "minjerk"))
             self._lid_value = behaviour.lid_closure
         self.rate_segments.append((t, behaviour.mode, blink_scale))
 
@@ -136,6 +139,7 @@ class Planner:
         self.begin(t0, b, blink_scale=b.blink_scale)
         rng = self.rng
         centre = np.asarray(b.gaze_offset_deg, dtype=float)
+        min_gap = float(gaze_model()["saccade"]["min_gap_s"])
         t = t0
         while t < t1:
             stats = mode_stats(self.mode(b, t))
@@ -152,7 +156,7 @@ class Planner:
                 mean, sd = stats.away_s
             self.shift(t, gaze, self._head_for(gaze, b), kind)
             interval = sample_interval(rng, mean, sd) * b.interval_scale
-            t += max(interval, self.saccades[-1].duration + 0.05)
+            t += max(interval, self.saccades[-1].duration + min_gap)
 
     def _away_target(
         self, b: BoundBehaviour, mode_max: float, mode_percent: tuple[float, ...]

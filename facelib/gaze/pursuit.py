@@ -28,6 +28,21 @@ class PursuitPath:
     catch_ups: tuple[tuple[float, float, tuple[float, float]], ...]
 
 
+def _sampled(
+    target_t: np.ndarray, target: np.ndarray, *, dt: float, latency: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The target on the simulation grid: times (n,) s every ``dt`` from 0, x and y (n,)
+    degrees, and velocity (n, 2) deg/s (zero before ``latency``: nothing seen yet)."""
+    target_t = np.asarray(target_t, dtype=float)
+    target = np.asarray(target, dtype=float)
+    t = np.arange(0.0, float(target_t[-1]) + 0.5 * dt, dt)
+    tx = np.interp(t, target_t, target[:, 0])
+    ty = np.interp(t, target_t, target[:, 1])
+    vel = np.gradient(np.column_stack([tx, ty]), dt, axis=0) if t.size > 1 else np.zeros((1, 2))
+    vel[t < latency] = 0.0
+    return t, tx, ty, vel
+
+
 def pursue_path(
     target_t: np.ndarray, target: np.ndarray, *, start_gaze: tuple[float, float]
 ) -> PursuitPath:
@@ -45,15 +60,8 @@ def pursue_path(
     dt = float(p["step_s"])
     latency, gain, tau = float(p["latency_s"]), float(p["gain"]), float(p["velocity_tau_s"])
     vmax, threshold = float(p["max_velocity_deg_s"]), float(p["catch_up_threshold_deg"])
-    target_t = np.asarray(target_t, dtype=float)
-    target = np.asarray(target, dtype=float)
-    end = float(target_t[-1])
-    t = np.arange(0.0, end + 0.5 * dt, dt)
-    tx = np.interp(t, target_t, target[:, 0])
-    ty = np.interp(t, target_t, target[:, 1])
+    t, tx, ty, vel = _sampled(target_t, target, dt=dt, latency=latency)
     seen_idx = np.clip(np.round((t - latency) / dt).astype(int), 0, t.size - 1)
-    vel = np.gradient(np.column_stack([tx, ty]), dt, axis=0) if t.size > 1 else np.zeros((1, 2))
-    vel[t < latency] = 0.0
 
     gaze = np.empty((t.size, 2))
     smooth = np.asarray(start_gaze, dtype=float).copy()

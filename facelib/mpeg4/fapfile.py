@@ -54,7 +54,6 @@ from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 __all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
 
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
-_WRITE_DIALECTS = ("standard", "xface", "greta", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
 _GROUP = {0: len(VISEME_FIELDS), 1: len(EXPRESSION_FIELDS)}
 _FIELD_LIMITS = {0: VISEME_LIMITS, 1: EXPRESSION_LIMITS}
@@ -166,20 +165,7 @@ class _Parser:
         if n_frames > most:
             raise self.error(first, f"the header declares {n_frames} frames, but a file of "
                              f"{self.size} bytes cannot describe more than {most}")
-        frames: list[_Frame]
-        frames, value_lines, width, dialect = [], [], 0, "standard"
-        for mask_line in body:
-            value_line = next(body, None)
-            if value_line is None:
-                raise self.error(mask_line, "truncated frame: a mask line without its value line")
-            if not frames:
-                width = len(mask_line.tokens)
-                dialect = self.dialect(mask_line, width, version)
-            frames.append(self.frame(mask_line, value_line, width, dialect))
-            value_lines.append(value_line)
-            if len(frames) > n_frames + 1:
-                raise self.error(value_line, f"more frames than the {n_frames} the header "
-                                 "declares")
+        frames, value_lines, dialect = self.frames(body, n_frames, version)
         if not frames:
             if n_frames:
                 raise self.error(first, f"the header declares {n_frames} frames but "
@@ -196,6 +182,26 @@ class _Parser:
             dialect = "xface"
         return self.assemble(frames, value_lines, fps=fps, n_frames=n_frames, name=name,
                              version=version, dialect=dialect)
+
+    def frames(self, body: Iterator[_Line], n_frames: int, version: str
+               ) -> tuple[list[_Frame], list[_Line], str]:
+        """Every (mask line, value line) pair parsed, their value lines and the dialect."""
+        frames: list[_Frame] = []
+        value_lines: list[_Line] = []
+        width, dialect = 0, "standard"
+        for mask_line in body:
+            value_line = next(body, None)
+            if value_line is None:
+                raise self.error(mask_line, "truncated frame: a mask line without its value line")
+            if not frames:
+                width = len(mask_line.tokens)
+                dialect = self.dialect(mask_line, width, version)
+            frames.append(self.frame(mask_line, value_line, width, dialect))
+            value_lines.append(value_line)
+            if len(frames) > n_frames + 1:
+                raise self.error(value_line, f"more frames than the {n_frames} the header "
+                                 "declares")
+        return frames, value_lines, dialect
 
     def header(self, line: _Line) -> tuple[str, str, float, int]:
         expected = "expected '<version> <name> <fps> <n_frames>'"
@@ -366,6 +372,15 @@ def _spans(numbers: tuple[int, ...]) -> str:
     return ", ".join(text) + (", ..." if len(spans) > 5 else "")
 
 
+def _check_range(stream: FapStream) -> None:
+    """ParameterError naming the first frame and FAP whose value a ``.fap`` cannot hold."""
+    too_big = np.argwhere(np.abs(stream.values) > VALUE_LIMIT)
+    if too_big.size:
+        frame, column = (int(i) for i in too_big[0])
+        raise ParameterError(f"frame {frame} FAP {column + 1} is {stream.values[frame, column]:g},"
+                             f" beyond the .fap format's range (+-{VALUE_LIMIT})")
+
+
 def write_fap(
     stream: FapStream,
     path: str | os.PathLike[str],
@@ -382,30 +397,29 @@ def write_fap(
     path:
         The file to write.
     dialect:
-        ``"standard"`` (68 mask tokens, integer values: every player reads it),
-        ``"xface"`` (standard plus the FAP 1/2 token groups), ``"greta"`` (69 mask
-        tokens) or ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2).
+        Any of :data:`DIALECTS`, each read back as that dialect: ``"standard"`` (68 mask
+        tokens, integer values: every player reads it), ``"xface"`` (68 mask tokens, values
+        with decimals, plus the FAP 1/2 token groups), ``"greta"`` (69 mask tokens),
+        ``"vreng"`` (standard with frames numbered from 1, tab-separated) or
+        ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2).
     name:
         The header's name; default: the file's stem. Spaces become underscores.
 
     Returns the path written.
     """
-    if dialect not in _WRITE_DIALECTS:
-        raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {_WRITE_DIALECTS}")
+    if dialect not in DIALECTS:
+        raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
+    _check_range(stream)
     path = Path(path)
     label = "_".join((name if name is not None else path.stem).split()) or "facelib"
-    width = {"standard": N_STANDARD_FAPS, "xface": N_STANDARD_FAPS,
-             "greta": _GRETA_MASK, "extended": N_FAPS}[dialect]
+    width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
-    too_big = np.argwhere(np.abs(stream.values) > VALUE_LIMIT)
-    if too_big.size:
-        frame, column = (int(i) for i in too_big[0])
-        raise ParameterError(f"frame {frame} FAP {column + 1} is {stream.values[frame, column]:g},"
-                             f" beyond the .fap format's range (+-{VALUE_LIMIT})")
-    values = np.rint(stream.values).astype(np.int64)
+    values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
+        str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
+    first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
     mask = np.zeros((stream.n_frames, width), bool)
     mask[:, : min(width, N_FAPS)] = stream.mask[:, : min(width, N_FAPS)]
     if not high_level:
@@ -415,15 +429,21 @@ def write_fap(
         mask[:, 1] &= stream.expression is not None
     out = [f"2.1 {label} {int(stream.fps)} {stream.n_frames}"]
     for i in range(stream.n_frames):
-        out.append(" ".join("1" if m else "0" for m in mask[i]))
-        tokens = [str(i)]
+        out.append(sep.join("1" if m else "0" for m in mask[i]))
+        tokens = [str(i + first)]
         for slot in np.flatnonzero(mask[i]):
             if slot == 0:
                 tokens += [str(int(v)) for v in stream.viseme[i]]  # type: ignore[index]
             elif slot == 1:
                 tokens += [str(int(v)) for v in stream.expression[i]]  # type: ignore[index]
             else:
-                tokens.append(str(values[i, slot]))
-        out.append(" ".join(tokens))
+                tokens.append(values[i * N_FAPS + slot])
+        out.append(sep.join(tokens))
     write_text_atomic(path, "\n".join(out) + "\n")
     return path
+
+
+def _decimal(value: float) -> str:
+    """``value`` with up to 3 decimals and at least one (``100.0``, ``-12.5``)."""
+    text = f"{value:.3f}".rstrip("0")
+    return text + "0" if text.endswith(".") else text

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -161,7 +160,9 @@ class FapStream:
             raise ParameterError(f"bad time span [{start}, {stop}) seconds")
         return self[max(first, 0) : min(last, self.n_frames)]
 
-    def _take(self, index: Any, fps: float, *, values: np.ndarray | None = None) -> FapStream:
+    def _take(
+        self, index: slice | np.ndarray, fps: float, *, values: np.ndarray | None = None
+    ) -> FapStream:
         """Frames ``index`` (a slice or an index array) at ``fps``, optionally with new
         ``values`` for them."""
         return FapStream(

@@ -11,15 +11,17 @@ its FAPU distance; a rotation FAP of 1 is 1e-5 rad (``ANGLE_UNIT``).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
+from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
 
 from facelib import data
 from facelib.checks import did_you_mean
-from facelib.errors import ParameterError
+from facelib.errors import DataError, ParameterError
 
 __all__ = [
     "ANGLE_UNIT",
@@ -31,6 +33,7 @@ __all__ = [
     "Fap",
     "FeaturePoint",
     "fap",
+    "fap_groups",
     "fap_table",
     "feature_point",
     "feature_point_table",
@@ -147,8 +150,17 @@ def fap_table() -> tuple[Fap, ...]:
         for row in rows
     )
     if [f.id for f in faps] != list(range(1, N_FAPS + 1)):  # pragma: no cover - data check
-        raise RuntimeError("facelib/data/mpeg4_faps.csv must list FAPs 1-84 in order")
+        raise DataError("must list FAPs 1-84 in order", path=str(data.path("mpeg4_faps.csv")))
     return faps
+
+
+@cache
+def fap_groups() -> Mapping[int, str]:
+    """FAP group number -> its name in the standard (``mpeg4_fap_groups.csv``); every
+    :attr:`Fap.group` is one of them."""
+    return MappingProxyType(
+        {int(row["group"]): row["name"] for _, row in data.csv_rows("mpeg4_fap_groups.csv")}
+    )
 
 
 @cache

@@ -123,13 +123,7 @@ def render(
     offset = source_offset if audio_offset is None else float(audio_offset)
     face = face_or_default(face)
     if out is not None and Path(out).suffix.lower() == ".png":
-        if stream.n_frames != 1:
-            raise ParameterError(
-                f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
-                "give a folder to write one PNG per frame"
-            )
-        return save_png(render_still(face, stream.values[0], width=width, height=height,
-                                     background=background), out)
+        return _one_png(face, stream, out, width=width, height=height, background=background)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
     with FaceRenderer(face, width=width, height=height, background=background) as renderer:
@@ -139,18 +133,40 @@ def render(
             for i, image in enumerate(frames):
                 result[i] = image
             return result
-        writer = open_writer(
-            out, fps=stream.fps, width=width, height=height,
-            audio=audio if Path(out).suffix.lower() == ".mp4" else None,
-            audio_offset=offset, duration=stream.duration,
+        mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
+        return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
+                      audio_offset=offset)
+
+
+def _one_png(
+    face: Deformable, stream: FapStream, out: str | os.PathLike[str], *, width: int,
+    height: int, background: Sequence[float] | None,
+) -> Path:
+    """A single-frame stream rendered to the PNG ``out``."""
+    if stream.n_frames != 1:
+        raise ParameterError(
+            f"{Path(out).name!r} is one PNG but the stream has {stream.n_frames} frames; "
+            "give a folder to write one PNG per frame"
         )
-        try:
-            for image in frames:
-                writer.write(image)
-        except BaseException:
-            writer.abort()
-            raise
-        return writer.commit()
+    return save_png(render_still(face, stream.values[0], width=width, height=height,
+                                 background=background), out)
+
+
+def _write(
+    frames: Iterator[np.ndarray], out: str | os.PathLike[str], stream: FapStream, *,
+    width: int, height: int, audio: Path | None, audio_offset: float,
+) -> Path:
+    """Write ``frames`` (each ``(height, width, 3) uint8``) to ``out`` at the stream's
+    frame rate; a failure removes what was written."""
+    writer = open_writer(out, fps=stream.fps, width=width, height=height, audio=audio,
+                         audio_offset=audio_offset, duration=stream.duration)
+    try:
+        for image in frames:
+            writer.write(image)
+    except BaseException:
+        writer.abort()
+        raise
+    return writer.commit()
 
 
 def render_still(

@@ -12,7 +12,7 @@ plausibility checks then warn or raise naming the word.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import cache
 from pathlib import Path
 from typing import Any, Literal
@@ -251,7 +251,7 @@ def _phone_loop(pcm: bytes, duration_ms: int) -> tuple[Span, ...]:
     return _cover(spans, duration_ms)
 
 
-def _frame_to_ms(duration_ms: int) -> Any:
+def _frame_to_ms(duration_ms: int) -> Callable[[int], int]:
     """Frame index (of the padded audio) -> ms in the audio, clipped to [0, duration_ms]."""
     settings = alignment_settings()
     pad, frame = settings["pad_ms"], settings["frame_ms"]

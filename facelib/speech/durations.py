@@ -3,21 +3,14 @@ while a writer drafts a storyboard before the voice is recorded."""
 
 from __future__ import annotations
 
-from facelib.errors import MissingExtraError, ParameterError, SpeechError
+from facelib.checks import check_number
+from facelib.errors import MissingExtraError, SpeechError
 from facelib.speech.pronounce import letter_to_sound, pronounce, tokenize
+from facelib.speech.tables import DurationRules, duration_rules, phone_durations
 from facelib.speech.tables import pauses as pause_table
-from facelib.speech.tables import phone_durations
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 
-__all__ = ["FINAL_LENGTHENING", "SHORT_WORD_VOWEL", "timeline_from_text"]
-
-FINAL_LENGTHENING = 1.4
-"""Phrase-final lengthening of the last phone before a pause (Klatt 1979 rule: x1.4)."""
-SHORT_WORD_VOWEL = 0.7
-"""Vowels of short one-vowel words (a, the, of, to, is, ...), usually unstressed, shortened."""
-_VOWELS = frozenset(
-    ("AA", "AE", "AH", "AO", "AW", "AY", "EH", "ER", "EY", "IH", "IY", "OW", "OY", "UH", "UW")
-)
+__all__ = ["timeline_from_text"]
 
 
 def _phones_of(word: str) -> tuple[str, ...]:
@@ -31,10 +24,9 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
     """Phones and words of ``text`` spoken at ``rate`` (1.0 is about 160 words per
     minute; 2.0 twice as fast), from the duration model (``phone_durations.csv``, pauses at
     punctuation from ``pauses.csv``). Times in ms from 0; ``source="durations"``."""
-    if not (isinstance(rate, (int, float)) and 0.25 <= rate <= 4):
-        raise ParameterError(f"speaking rate must be between 0.25 and 4, got {rate!r}")
+    rate = check_number("rate", rate, low=0.25, high=4.0)
     pauses = pause_table()
-    table = phone_durations()
+    rules = duration_rules()
     tokens = tokenize(text)
     phones: list[Span] = []
     words: list[Span] = []
@@ -46,18 +38,8 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
             continue
         following = tokens[k + 1] if k + 1 < len(tokens) else None
         pause = pauses.get(following, 0) if following else pauses["edge"]
-        word_phones = _phones_of(token)
-        n_vowels = sum(p in _VOWELS for p in word_phones)
         start = t
-        for i, phone in enumerate(word_phones):
-            if phone not in table:
-                raise SpeechError(f"no duration for phone {phone!r} of word {token!r}")
-            mean, least = table[phone]
-            factor = SHORT_WORD_VOWEL if (phone in _VOWELS and n_vowels == 1
-                                          and len(token) <= 3) else 1.0
-            if pause and i == len(word_phones) - 1:
-                factor *= FINAL_LENGTHENING
-            ms = max(round(max(mean * factor, least) / rate), 10)
+        for phone, ms in _word_durations(token, final=bool(pause), rate=rate, rules=rules):
             phones.append(Span(phone, t, t + ms))
             t += ms
         words.append(Span(token, start, t))
@@ -69,6 +51,29 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
     phones = _join_silences(phones)
     words = _join_silences(words)
     return PhoneTimeline(tuple(phones), tuple(words), "durations", t)
+
+
+def _word_durations(
+    word: str, *, final: bool, rate: float, rules: DurationRules
+) -> list[tuple[str, int]]:
+    """(phone, ms) of ``word``: each phone's mean duration, shortened if it is the vowel of
+    a short one-vowel word, lengthened if it ends a phrase (``final``), never below the
+    phone's minimum, scaled by ``rate`` and floored at ``rules.floor_ms``."""
+    table = phone_durations()
+    word_phones = _phones_of(word)
+    n_vowels = sum(p in rules.vowels for p in word_phones)
+    out = []
+    for i, phone in enumerate(word_phones):
+        if phone not in table:
+            raise SpeechError(f"no duration for phone {phone!r} of word {word!r}")
+        mean, least = table[phone]
+        short = (phone in rules.vowels and n_vowels == 1
+                 and len(word) <= rules.short_word_max_letters)
+        factor = rules.short_word_vowel if short else 1.0
+        if final and i == len(word_phones) - 1:
+            factor *= rules.final_lengthening
+        out.append((phone, max(round(max(mean * factor, least) / rate), rules.floor_ms)))
+    return out
 
 
 def _join_silences(spans: list[Span]) -> list[Span]:

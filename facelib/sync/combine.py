@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from facelib.checks import check_seed
+from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import ANGLE_UNIT, fap
 from facelib.mpeg4.track import FapTrack
@@ -46,11 +48,12 @@ def blend(a: FapTrack, b: FapTrack, *, weight_a: float, weight_b: float) -> FapT
 
 
 def close_lids(
-    track: FapTrack, closure: np.ndarray, *, closed: tuple[float, float] = (1024.0, 0.0)
+    track: FapTrack, closure: np.ndarray, *, closed: tuple[float, float]
 ) -> FapTrack:
     """Blinks: move the lids ``closure`` (``(n_frames,)`` in [0, 1]) of the way from where
-    they are to ``closed`` (upper, lower lid values in IRISD units; 1024 is a full upper-lid
-    travel); 1 closes the eye whatever an expression or gaze asked of the lids."""
+    they are to ``closed`` (upper, lower lid values in IRISD units, the eye model's
+    ``GazeAnimation.blink_lids``); 1 closes the eye whatever an expression or gaze asked of
+    the lids."""
     closure = np.asarray(closure, np.float64)[:, None]
     values = track.values.astype(np.float64)
     weight = track.weight.copy()
@@ -112,7 +115,7 @@ def combine(
     visemes: FapTrack,
     gaze: FapTrack,
     blinks: np.ndarray | None = None,
-    blink_lids: tuple[float, float] = (1024.0, 0.0),
+    blink_lids: tuple[float, float] | None = None,
     speaking: np.ndarray | None = None,
     rules: SyncRules | None = None,
     seed: int = 0,
@@ -121,13 +124,17 @@ def combine(
 
     gaze: the eye track with its lids open (blinks are applied after the lid blend).
     blinks: ``(n_frames,)`` lid closure in [0, 1] from the eye-behaviour model, or None;
-    blink_lids: the (upper, lower) lid values at full closure.
+    blink_lids: the (upper, lower) lid values at full closure (``GazeAnimation.blink_lids``);
+        needed with ``blinks``.
     speaking: ``(n_frames,) bool`` where the character talks (livelier head noise).
     """
+    seed = check_seed(seed)
     rules = rules or SyncRules.load()
     face = blend(expressions, visemes, weight_a=rules.mouth[0], weight_b=rules.mouth[1])
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
     if blinks is not None:
+        if blink_lids is None:
+            raise ParameterError("combine: blinks need blink_lids (GazeAnimation.blink_lids)")
         face = close_lids(face, blinks, closed=blink_lids)
     if rules.head_noise is not None:
         head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)

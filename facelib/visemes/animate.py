@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.checks import check_fps
+from facelib.checks import check_fps, check_number
 from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
 from facelib.errors import SpeechError
 from facelib.mpeg4.track import FapTrack
@@ -101,6 +101,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     ``max_frames`` raises SpeechError before the curves are computed.
     """
     fps = check_fps(fps)
+    rate = check_number("rate", rate, low=0.25, high=4.0)
     timeline = speech_timeline(speech, rate=rate).shifted(speech.start_ms)
     end_ms = speech.start_ms + timeline.duration_ms
     n_frames = math.floor(end_ms * fps / 1000) + 1

@@ -16,12 +16,12 @@ span: ``tier  label  start  end  viseme``. The ``Sentence`` script is Lua, one
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from facelib.atomic import write_text_atomic
+from facelib.checks import check_fps
 from facelib.cues import VisemeCue
 from facelib.errors import FdlError, ParameterError
 from facelib.visemes.tables import script_name, viseme_id, viseme_name
@@ -58,7 +58,7 @@ def timeline_to_json(timeline: SpeechTimeline) -> dict[str, Any]:
 def timeline_from_json(data: Mapping[str, Any]) -> SpeechTimeline:
     """Inverse of :func:`timeline_to_json` (times rounded to whole ms)."""
     try:
-        def ms(x: Any) -> int:
+        def ms(x: float | str) -> int:
             return round(float(x) * 1000)
 
         phones = tuple(Span(p["phone"], ms(p["start"]), ms(p["end"])) for p in data["phones"])
@@ -99,8 +99,7 @@ def timeline_to_sentence(timeline: SpeechTimeline, *, fps: float) -> str:
     Durations are whole frames at ``fps``; boundaries are rounded once each (no drift), and
     a viseme that rounds to no frame is left out.
     """
-    if not (isinstance(fps, (int, float)) and fps > 0):
-        raise ParameterError(f"fps must be a positive number, got {fps!r}")
+    fps = check_fps(fps)
     header = f"-- viseme script: {len(timeline.visemes)} visemes, frames at {fps:g} fps"
     lines = [header, "Sentence = {"]
     for v in timeline.visemes:
@@ -139,12 +138,5 @@ def write_timeline(timeline: SpeechTimeline, path: str | Path, *, fps: float = 2
     else:
         raise ParameterError(f"unknown timeline format {path.suffix!r} of {path}; "
                              "use .json, .tsv or .sb")
-    fd, tmp = tempfile.mkstemp(dir=path.parent or ".", prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        Path(tmp).replace(path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_text_atomic(path, text)
     return path

@@ -37,8 +37,7 @@ def test_raised_cosine_averages_several_points() -> None:
     assert w[2, 0] == pytest.approx(w[2, 1])
 
 
-def test_rbf_interpolates_controls_and_pins_anchors() -> None:
-    rng = np.random.default_rng(3)
+def test_rbf_interpolates_controls_and_pins_anchors(rng: np.random.Generator) -> None:
     controls = rng.uniform(-1, 1, (5, 3))
     angles = np.linspace(0, 2 * np.pi, 24, endpoint=False)
     anchors = np.stack([3 * np.cos(angles), 3 * np.sin(angles), np.zeros_like(angles)], 1)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facelib.engine import PART_NAMES, Face, load_face
+from facelib.engine import PART_NAMES, Face
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap, fap_table
@@ -14,15 +14,8 @@ EYELID_FAPS = (19, 20, 21, 22)
 
 
 @pytest.fixture(scope="module")
-def face() -> Face:
-    return load_face()
-
-
-def frame(**values: float) -> np.ndarray:
-    out = np.zeros(84, np.float32)
-    for name, v in values.items():
-        out[fap(name).index] = v
-    return out
+def face(default_face: Face) -> Face:
+    return default_face
 
 
 def test_mesh_arrays_and_parts(face: Face) -> None:
@@ -86,11 +79,11 @@ def _translational():
 
 
 @pytest.mark.parametrize("fap_id", [f.id for f in _translational()])
-def test_translation_fap_moves_its_point(face: Face, fap_id: int) -> None:
+def test_translation_fap_moves_its_point(face: Face, fap_id: int, fap_frame) -> None:
     f = fap(fap_id)
     value = 200.0
     p = face.feature_points[f.feature_points[0]]
-    moved = face.deform_frame(frame(**{f.name: value})).astype(np.float64)
+    moved = face.deform_frame(fap_frame(**{f.name: value})).astype(np.float64)
     rest = face.vertices.astype(np.float64)
     delta = moved[p] - rest[p]
     expected = value * face.fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
@@ -108,9 +101,9 @@ def test_translation_fap_moves_its_point(face: Face, fap_id: int) -> None:
     assert np.abs(moved[far] - rest[far]).max() < 1e-7
 
 
-def test_deformation_is_linear_in_translation_faps(face: Face) -> None:
-    a = frame(raise_b_midlip=150, stretch_l_cornerlip=-80, raise_l_i_eyebrow=100)
-    b = frame(lower_t_midlip=-60, puff_r_cheek=200, raise_nose=50)
+def test_deformation_is_linear_in_translation_faps(face: Face, fap_frame) -> None:
+    a = fap_frame(raise_b_midlip=150, stretch_l_cornerlip=-80, raise_l_i_eyebrow=100)
+    b = fap_frame(lower_t_midlip=-60, puff_r_cheek=200, raise_nose=50)
     rest = face.vertices
     da, db = face.deform_frame(a) - rest, face.deform_frame(b) - rest
     dab = face.deform_frame(a + b) - rest
@@ -128,10 +121,12 @@ def _angle(u: np.ndarray, v: np.ndarray) -> float:
     ("pitch_l_eyeball", "3.5", "eye_l", 1, -1.0),
     ("pitch_r_eyeball", "3.6", "eye_r", 1, -1.0),
 ])
-def test_eyeball_rotates_by_the_angle(face: Face, name, pupil, pivot, *, axis, sign) -> None:
+def test_eyeball_rotates_by_the_angle(
+    face: Face, name, pupil, pivot, *, axis, sign, fap_frame
+) -> None:
     p = face.feature_points[pupil]
     c = face.pivots[pivot]
-    moved = face.deform_frame(frame(**{name: 20000}))
+    moved = face.deform_frame(fap_frame(**{name: 20000}))
     before = face.vertices[p] - c
     after = moved[p] - c
     assert _angle(before, after) == pytest.approx(0.2, rel=1e-3)
@@ -147,10 +142,10 @@ def test_eyeball_rotates_by_the_angle(face: Face, name, pupil, pivot, *, axis, s
     ("head_yaw", (0, 2), 0),
     ("head_pitch", (1, 2), 1),
 ])
-def test_head_rotates_about_its_pivot(face: Face, name, plane, sign_axis) -> None:
+def test_head_rotates_about_its_pivot(face: Face, name, plane, sign_axis, fap_frame) -> None:
     tip = face.feature_points["9.3"]
     h = face.pivots["head"]
-    moved = face.deform_frame(frame(**{name: 15000}))
+    moved = face.deform_frame(fap_frame(**{name: 15000}))
     before, after = (face.vertices[tip] - h)[list(plane)], (moved[tip] - h)[list(plane)]
     assert _angle(before, after) == pytest.approx(0.15, rel=1e-3)
     direction = 1.0 if name == "head_yaw" else -1.0  # yaw left (+x), pitch down (-y)
@@ -160,16 +155,16 @@ def test_head_rotates_about_its_pivot(face: Face, name, plane, sign_axis) -> Non
     np.testing.assert_allclose(moved[low], face.vertices[low], atol=1e-6)
 
 
-def test_head_roll_tips_the_top_to_the_right(face: Face) -> None:
+def test_head_roll_tips_the_top_to_the_right(face: Face, fap_frame) -> None:
     top = int(np.argmax(face.vertices[:, 1]))
-    moved = face.deform_frame(frame(head_roll=10000))
+    moved = face.deform_frame(fap_frame(head_roll=10000))
     assert moved[top, 0] < face.vertices[top, 0] - 0.005
 
 
-def test_lips_part_by_the_jaw_displacement(face: Face) -> None:
+def test_lips_part_by_the_jaw_displacement(face: Face, fap_frame) -> None:
     value = 600.0
     drop = value * face.fapu["MNS"]
-    moved = face.deform_frame(frame(open_jaw=value))
+    moved = face.deform_frame(fap_frame(open_jaw=value))
     up, lo = face.feature_points["2.2"], face.feature_points["2.3"]
     gap0 = face.vertices[up, 1] - face.vertices[lo, 1]
     gap1 = moved[up, 1] - moved[lo, 1]
@@ -227,8 +222,8 @@ def test_mouth_cavity_is_dark(face: Face) -> None:
     assert face.vertex_colors[deep].max() < 0.3
 
 
-def test_eyelids_close_over_the_eye_without_cutting_it(face: Face) -> None:
-    moved = face.deform_frame(frame(close_t_l_eyelid=1024, close_t_r_eyelid=1024))
+def test_eyelids_close_over_the_eye_without_cutting_it(face: Face, fap_frame) -> None:
+    moved = face.deform_frame(fap_frame(close_t_l_eyelid=1024, close_t_r_eyelid=1024))
     for top, bottom, eye in (("3.1", "3.3", "eye_l"), ("3.2", "3.4", "eye_r")):
         t, b = face.feature_points[top], face.feature_points[bottom]
         assert moved[t, 1] == pytest.approx(face.vertices[b, 1], abs=2e-4)
@@ -240,8 +235,7 @@ def test_eyelids_close_over_the_eye_without_cutting_it(face: Face) -> None:
         assert np.all(np.linalg.norm(moved[lid][outside] - c, axis=1) > radius)
 
 
-def test_deform_stream_matches_frames(face: Face) -> None:
-    rng = np.random.default_rng(7)
+def test_deform_stream_matches_frames(face: Face, rng: np.random.Generator) -> None:
     values = np.zeros((5, 84), np.float32)
     values[:, 2:68] = rng.uniform(-150, 150, (5, 66))
     values[:, 2] = np.abs(values[:, 2])

@@ -8,7 +8,7 @@ import pytest
 from facelib import fdl
 
 DOC = Path(__file__).parents[2] / "docs" / "fdl.md"
-DATA = Path(__file__).parent / "data" / "thesis"
+DATA = Path(__file__).parents[1] / "data" / "fdl" / "thesis"
 EXAMPLES = re.findall(r"```lua\n(.*?)```", DOC.read_text(), re.DOTALL)
 
 

@@ -8,7 +8,7 @@ from facelib import fdl
 from facelib.errors import FdlError
 from facelib.fdl.marking import mark_tables
 
-DATA = Path(__file__).parent / "data" / "thesis"
+DATA = Path(__file__).parents[1] / "data" / "fdl" / "thesis"
 
 
 def test_definitions_and_local_mix():

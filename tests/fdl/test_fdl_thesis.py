@@ -7,7 +7,7 @@ import pytest
 from facelib import fdl
 from facelib.errors import FdlError
 
-DATA = Path(__file__).parent / "data" / "thesis"
+DATA = Path(__file__).parents[1] / "data" / "fdl" / "thesis"
 
 
 def test_thesis_storyboard_verbatim():

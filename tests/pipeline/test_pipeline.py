@@ -12,27 +12,28 @@ from facelib.fdl import loads
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent.parent
-GOLDEN = HERE / "data" / "small.golden.fap"
+DATA = HERE.parent / "data" / "pipeline"
+GOLDEN = DATA / "small.golden.fap"
 NOISY = {*range(19, 27), 48, 49, 50}  # gaze, blinks and head noise: the seeded parts
 
 
 def test_same_seed_same_stream_bit_for_bit():
-    a = run_fdl(HERE / "data" / "small.fdl")
-    b = run_fdl(HERE / "data" / "small.fdl")
+    a = run_fdl(DATA / "small.fdl")
+    b = run_fdl(DATA / "small.fdl")
     assert isinstance(a, Animation)
     assert a.faps == b.faps
 
 
 def test_another_seed_changes_only_the_noisy_parts():
-    a = run_fdl(HERE / "data" / "small.fdl")
-    c = run_fdl(HERE / "data" / "small.fdl", seed=99)
+    a = run_fdl(DATA / "small.fdl")
+    c = run_fdl(DATA / "small.fdl", seed=99)
     changed = {int(i) + 1 for i in np.flatnonzero((a.faps.values != c.faps.values).any(0))}
     assert changed
     assert changed <= NOISY
 
 
 def test_stream_lasts_as_long_as_the_longest_track():
-    anim = run_fdl(HERE / "data" / "small.fdl")
+    anim = run_fdl(DATA / "small.fdl")
     assert anim.faps.duration * 1000 >= anim.storyboard.cues_end_ms
     assert anim.faps.duration * 1000 >= anim.visemes[-1].end_ms
     assert anim.tracks["visemes"].n_frames == anim.faps.n_frames
@@ -41,7 +42,7 @@ def test_stream_lasts_as_long_as_the_longest_track():
 def test_golden_stream():
     """The small storyboard's stream, pinned. After an intended change of the animation,
     regenerate with: FACELIB_REGENERATE=1 pytest tests/pipeline -k golden"""
-    stream = run_fdl(HERE / "data" / "small.fdl").faps
+    stream = run_fdl(DATA / "small.fdl").faps
     if os.environ.get("FACELIB_REGENERATE"):
         write_fap(stream, GOLDEN, dialect="extended")
     golden = read_fap(GOLDEN, strict=True)
@@ -51,7 +52,7 @@ def test_golden_stream():
 
 
 def test_expressions_and_visemes_share_the_mouth_as_eq_4_11():
-    anim = run_fdl(HERE / "data" / "small.fdl")
+    anim = run_fdl(DATA / "small.fdl")
     e, v = anim.tracks["expressions"], anim.tracks["visemes"]
     col = fap("open_jaw").index
     both = (e.weight[:, col] == 1) & (v.weight[:, col] == 1)

@@ -50,7 +50,7 @@ def test_gaze_expression_conflict_is_25_75():
 
 def test_blinks_close_the_lids_whatever_the_expression_says():
     face = _track(close_t_l_eyelid=(-200, 1))  # an expression holding the eye wide open
-    out = close_lids(face, np.array([0.0, 0.5, 1.0, 0.0]))
+    out = close_lids(face, np.array([0.0, 0.5, 1.0, 0.0]), closed=(1024.0, 0.0))
     assert out.values[:, LID].tolist() == pytest.approx([-200, 412, 1024, -200])
     assert out.values[2, fap("close_t_r_eyelid").index] == pytest.approx(1024)
 

@@ -12,7 +12,7 @@ from facelib.errors import SpeechError
 from facelib.mpeg4.tables import fap
 from facelib.visemes import animate, driven_faps, viseme_targets
 
-FIXTURES = Path(__file__).parent / "fixtures"
+FIXTURES = Path(__file__).parents[1] / "data" / "speech" / "alignment"
 
 
 def test_text_only_track_shape_weights_and_offset():
@@ -66,3 +66,11 @@ def test_audio_and_text_uses_alignment():
 def test_nothing_to_say():
     with pytest.raises(SpeechError, match=r"story\.fdl:7"):
         animate(SpeechSpec(origin=("story.fdl", 7)), fps=25)
+
+
+def test_numpy_frame_rates_are_accepted_as_fapstream_accepts_them():
+    spec = SpeechSpec(text="Hello there.")
+    plain = animate(spec, fps=25)
+    numpy_rate = animate(spec, fps=np.float32(25))  # used to raise ParameterError
+    assert numpy_rate.track.fps == 25.0
+    assert np.array_equal(plain.track.values, numpy_rate.track.values)

@@ -67,3 +67,17 @@ def test_unknown_script_viseme_names_file_and_line():
 def test_unknown_output_format(timeline, tmp_path):
     with pytest.raises(ParameterError, match=r"\.txt"):
         write_timeline(timeline, tmp_path / "x.txt")
+
+
+def test_write_timeline_makes_folders_and_normal_permissions(timeline, tmp_path):
+    import os
+    import stat
+
+    umask = os.umask(0o022)
+    try:
+        path = write_timeline(timeline, tmp_path / "new" / "folder" / "out.tsv")
+    finally:
+        os.umask(umask)
+    assert path.read_text().startswith(timeline_to_tsv(timeline)[:20])
+    assert stat.S_IMODE(path.stat().st_mode) == 0o644  # was 0600 from mkstemp
+    assert [p.name for p in path.parent.iterdir()] == ["out.tsv"]  # no temp file left

@@ -95,3 +95,19 @@ def test_ramps_that_do_not_fit_are_refused():
     cue = ExpressionCue("joy", 0, 100, ramp_in_ms=80, ramp_out_ms=80, origin=("a.fdl", 3))
     with pytest.raises(FdlError, match=r"a.fdl:3"):
         animate([cue], fps=25, n_frames=10)
+
+
+def test_unknown_names_suggest_only_close_ones():
+    library = default_library()
+    with pytest.raises(FdlError) as far:
+        library.get("nope")
+    assert "did you mean" not in str(far.value)  # it used to suggest 'inlove'
+    with pytest.raises(FdlError, match="did you mean 'joy'"):
+        library.get("joyy")
+
+
+def test_default_ramps_come_from_the_data_file():
+    from facelib.expressions.curves import default_ramp_ms
+
+    assert default_ramp_ms(10_000) == 400
+    assert default_ramp_ms(1000) == 250  # a quarter of a short cue

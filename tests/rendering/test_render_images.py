@@ -13,13 +13,6 @@ from facelib.rendering.scene import FaceRenderer
 W, H = 160, 120
 
 
-def faps(**values: float) -> np.ndarray:
-    out = np.zeros(84, np.float32)
-    for key, value in values.items():
-        out[int(key[1:]) - 1] = value
-    return out
-
-
 @pytest.fixture(scope="module")
 def renderer(synthetic_face):
     with FaceRenderer(synthetic_face, width=W, height=H) as r:
@@ -33,10 +26,10 @@ def _box(renderer, points, pad=2):
     return slice(max(r0, 0), min(r1, H)), slice(max(c0, 0), min(c1, W))
 
 
-def test_jaw_open_changes_mouth_not_forehead(renderer, synthetic_face):
+def test_jaw_open_changes_mouth_not_forehead(renderer, synthetic_face, fap_frame):
     face = synthetic_face
-    neutral = renderer.frame(face.deform_frame(faps()))
-    open_jaw = renderer.frame(face.deform_frame(faps(f3=700)))
+    neutral = renderer.frame(face.deform_frame(fap_frame()))
+    open_jaw = renderer.frame(face.deform_frame(fap_frame(f3=700)))
     diff = np.abs(neutral.astype(int) - open_jaw.astype(int)).sum(axis=2)
     front = face.vertices[:, 2] > 0.3
     mouth = face.vertices[np.intersect1d(face.jaw, np.flatnonzero(front))]
@@ -59,25 +52,27 @@ def _iris_centroid(image, renderer, face):
     return c.mean() + cols.start, r.mean() + rows.start
 
 
-def test_eyes_turned_to_the_faces_left_move_iris_to_image_right(renderer, synthetic_face):
+def test_eyes_turned_to_the_faces_left_move_iris_to_image_right(
+    renderer, synthetic_face, fap_frame
+):
     face = synthetic_face
-    x0, y0 = _iris_centroid(renderer.frame(face.deform_frame(faps())), renderer, face)
-    turn = faps(f23=50000, f24=50000)  # +0.5 rad toward the face's own left (+x)
+    x0, y0 = _iris_centroid(renderer.frame(face.deform_frame(fap_frame())), renderer, face)
+    turn = fap_frame(f23=50000, f24=50000)  # +0.5 rad toward the face's own left (+x)
     x1, y1 = _iris_centroid(renderer.frame(face.deform_frame(turn)), renderer, face)
-    back = faps(f23=-50000, f24=-50000)
+    back = fap_frame(f23=-50000, f24=-50000)
     x2, _ = _iris_centroid(renderer.frame(face.deform_frame(back)), renderer, face)
     # the camera faces the face, so the face's left is the image's right
     assert x1 - x0 > 2
     assert x0 - x2 > 2
     assert abs(y1 - y0) < 1.0
-    down = faps(f25=40000, f26=40000)  # pitch down
+    down = fap_frame(f25=40000, f26=40000)  # pitch down
     _, y3 = _iris_centroid(renderer.frame(face.deform_frame(down)), renderer, face)
     assert y3 - y0 > 1.5
 
 
-def test_buffer_update_matches_fresh_meshes(synthetic_face):
+def test_buffer_update_matches_fresh_meshes(synthetic_face, fap_frame):
     face = synthetic_face
-    poses = [faps(f3=500), faps(f23=20000, f24=20000), faps()]
+    poses = [fap_frame(f3=500), fap_frame(f23=20000, f24=20000), fap_frame()]
     with FaceRenderer(face, width=W, height=H, mesh_update="swap") as swap, \
             FaceRenderer(face, width=W, height=H, mesh_update="buffers") as buffers:
         for pose in poses:

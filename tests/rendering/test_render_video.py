@@ -13,17 +13,16 @@ import soundfile
 from PIL import Image
 
 from facelib.errors import ParameterError, RenderError
-from facelib.mpeg4.stream import FapStream
 from facelib.rendering.frames import render
 from facelib.rendering.video import encode_png, open_writer, probe_video, save_png
 
 W, H = 96, 72
 
 
-def _stream(n: int, fps: float = 25) -> FapStream:
-    values = np.zeros((n, 84), np.float32)
-    values[:, 2] = 700 * np.sin(np.linspace(0, np.pi, n))  # open and close the jaw
-    return FapStream(fps, values)
+@pytest.fixture
+def jaw_stream(fap_stream):
+    """``jaw_stream(n, fps)``: the jaw opens and closes once over ``n`` frames."""
+    return lambda n, fps=25: fap_stream(n, fps=fps, open_jaw=700 * np.sin(np.linspace(0, np.pi, n)))
 
 
 def _tone(path: Path, seconds: float, rate: int = 16000) -> Path:
@@ -32,8 +31,8 @@ def _tone(path: Path, seconds: float, rate: int = 16000) -> Path:
     return path
 
 
-def test_mp4_has_frame_count_duration_and_audio(tmp_path, synthetic_face):
-    stream = _stream(30)  # 1.2 s
+def test_mp4_has_frame_count_duration_and_audio(tmp_path, synthetic_face, jaw_stream):
+    stream = jaw_stream(30)  # 1.2 s
     speech = _tone(tmp_path / "speech.wav", 1.5)
     out = render(stream, face=synthetic_face, out=tmp_path / "a.mp4", width=W, height=H,
                  audio=speech, progress=False)
@@ -49,9 +48,9 @@ def test_mp4_has_frame_count_duration_and_audio(tmp_path, synthetic_face):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.mp4", "b.mp4", "speech.wav"]
 
 
-def test_animation_source_brings_its_audio(tmp_path, synthetic_face):
+def test_animation_source_brings_its_audio(tmp_path, synthetic_face, jaw_stream):
     class Animation:
-        faps = _stream(10, fps=20)
+        faps = jaw_stream(10, fps=20)
         audio = _tone(tmp_path / "s.wav", 0.5)
         audio_offset = 0.1
 
@@ -61,8 +60,8 @@ def test_animation_source_brings_its_audio(tmp_path, synthetic_face):
     assert info["frames"] == 10 and info["audio"] is True
 
 
-def test_png_folder_holds_the_same_frames(tmp_path, synthetic_face):
-    stream = _stream(4)
+def test_png_folder_holds_the_same_frames(tmp_path, synthetic_face, jaw_stream):
+    stream = jaw_stream(4)
     frames = render(stream, face=synthetic_face, width=W, height=H, progress=False)
     folder = render(stream, face=synthetic_face, out=tmp_path / "frames", width=W, height=H,
                     progress=False)
@@ -71,25 +70,24 @@ def test_png_folder_holds_the_same_frames(tmp_path, synthetic_face):
     for i, name in enumerate(names):
         assert np.array_equal(np.asarray(Image.open(folder / name)), frames[i])
     # rewriting the folder replaces its frames, leaving no temporaries beside it
-    render(_stream(2), face=synthetic_face, out=folder, width=W, height=H, progress=False)
+    render(jaw_stream(2), face=synthetic_face, out=folder, width=W, height=H, progress=False)
     assert len(list(folder.iterdir())) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["frames"]
 
 
-def test_gif_and_single_png(tmp_path, synthetic_face):
-    gif = render(_stream(5), face=synthetic_face, out=tmp_path / "a.gif", width=W, height=H,
+def test_gif_and_single_png(tmp_path, synthetic_face, jaw_stream):
+    gif = render(jaw_stream(5), face=synthetic_face, out=tmp_path / "a.gif", width=W, height=H,
                  progress=False)
     with Image.open(gif) as image:
         assert image.n_frames == 5 and image.size == (W, H)
-    still = render(_stream(1), face=synthetic_face, out=tmp_path / "one.png", width=W,
+    still = render(jaw_stream(1), face=synthetic_face, out=tmp_path / "one.png", width=W,
                    height=H, progress=False)
     assert np.asarray(Image.open(still)).shape == (H, W, 3)
     with pytest.raises(ParameterError, match="one PNG"):
-        render(_stream(3), face=synthetic_face, out=tmp_path / "x.png", width=W, height=H)
+        render(jaw_stream(3), face=synthetic_face, out=tmp_path / "x.png", width=W, height=H)
 
 
-def test_encode_png_round_trips():
-    rng = np.random.default_rng(4)
+def test_encode_png_round_trips(rng):
     for shape in ((5, 7, 3), (3, 2, 4)):
         image = rng.integers(0, 256, shape, dtype=np.uint8)
         assert np.array_equal(np.asarray(Image.open(io.BytesIO(encode_png(image)))), image)
@@ -97,7 +95,7 @@ def test_encode_png_round_trips():
         encode_png(np.zeros((4, 4, 3), np.float32))
 
 
-def test_failed_render_leaves_no_output(tmp_path, synthetic_face):
+def test_failed_render_leaves_no_output(tmp_path, synthetic_face, jaw_stream):
     class Broken:
         def __init__(self, face):
             self.__dict__.update({k: getattr(face, k) for k in
@@ -108,7 +106,7 @@ def test_failed_render_leaves_no_output(tmp_path, synthetic_face):
 
     target = tmp_path / "clip.mp4"
     with pytest.raises(RuntimeError, match="exploded"):
-        render(_stream(3), face=Broken(synthetic_face), out=target, width=W, height=H,
+        render(jaw_stream(3), face=Broken(synthetic_face), out=target, width=W, height=H,
                progress=False)
     assert list(tmp_path.iterdir()) == []
     save_png(np.zeros((4, 4, 3), np.uint8), tmp_path / "keep.png")
@@ -134,13 +132,13 @@ def test_writer_rejects_bad_requests(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["busy"]
 
 
-def test_outputs_get_ordinary_permissions(tmp_path, synthetic_face):
+def test_outputs_get_ordinary_permissions(tmp_path, synthetic_face, jaw_stream):
     old = os.umask(0o022)
     try:
         png = save_png(np.zeros((4, 4, 3), np.uint8), tmp_path / "a.png")
-        folder = render(_stream(1), face=synthetic_face, out=tmp_path / "f", width=W, height=H,
+        folder = render(jaw_stream(1), face=synthetic_face, out=tmp_path / "f", width=W, height=H,
                         progress=False)
-        gif = render(_stream(2), face=synthetic_face, out=tmp_path / "g.gif", width=W,
+        gif = render(jaw_stream(2), face=synthetic_face, out=tmp_path / "g.gif", width=W,
                      height=H, progress=False)
     finally:
         os.umask(old)

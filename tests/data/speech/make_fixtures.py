@@ -1,5 +1,6 @@
-"""Regenerate the committed speech fixtures of tests/visemes (needs festival and the
-festvox-us-slt-hts voice): ``PYTHONPATH=. .venv/bin/python tests/visemes/make_fixtures.py``.
+"""Regenerate the committed speech fixtures in tests/data/speech/alignment (needs festival
+and the festvox-us-slt-hts voice):
+``PYTHONPATH=. .venv/bin/python tests/data/speech/make_fixtures.py``.
 
 Each fixture is ``NAME.flac`` (16 kHz mono) plus ``NAME.tsv`` with the transcript on the
 first line (``# text: ...``) and Festival's exact phones (ARPAbet, start s, end s).
@@ -10,7 +11,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import soundfile  # noqa: E402
@@ -23,7 +24,7 @@ FIXTURES = {
 
 
 def main() -> None:
-    out = Path(__file__).parent / "fixtures"
+    out = Path(__file__).parent / "alignment"
     out.mkdir(exist_ok=True)
     for name, text in FIXTURES.items():
         wav = out / f"{name}.wav"

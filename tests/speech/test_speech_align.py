@@ -15,7 +15,7 @@ from facelib.visemes import SpeechWarning, align, timeline_to_json
 
 pytest.importorskip("pocketsphinx")
 
-FIXTURES = Path(__file__).parent / "fixtures"
+FIXTURES = Path(__file__).parents[1] / "data" / "speech" / "alignment"
 
 
 def load_truth(name: str) -> tuple[str, list[tuple[str, float]]]:

@@ -12,23 +12,16 @@ W, H = 200, 200
 
 
 @pytest.fixture(scope="module")
-def head():
-    face = engine.load_face(None)
+def head(default_face):
+    face = default_face
     with FaceRenderer(face, width=W, height=H) as renderer:
         yield face, renderer
 
 
-def _faps(**values: float) -> np.ndarray:
-    out = np.zeros(84, np.float32)
-    for key, value in values.items():
-        out[int(key[1:]) - 1] = value
-    return out
-
-
-def test_jaw_open_moves_mouth_pixels_not_forehead(head):
+def test_jaw_open_moves_mouth_pixels_not_forehead(head, fap_frame):
     face, renderer = head
-    neutral = renderer.frame(face.deform_frame(_faps()))
-    opened = renderer.frame(face.deform_frame(_faps(f3=600)))
+    neutral = renderer.frame(face.deform_frame(fap_frame()))
+    opened = renderer.frame(face.deform_frame(fap_frame(f3=600)))
     diff = np.abs(neutral.astype(int) - opened.astype(int)).sum(axis=2)
     chin_row = renderer.project(face.vertices[face.feature_points["2.1"]])[0, 1]
     eye_row = renderer.project(face.pivots["eye_l"])[0, 1]
@@ -38,7 +31,7 @@ def test_jaw_open_moves_mouth_pixels_not_forehead(head):
     assert np.abs(changed - chin_row).min() < 10  # the change is around the mouth and chin
 
 
-def test_eyes_turned_left_move_the_iris_right_in_the_image(head):
+def test_eyes_turned_left_move_the_iris_right_in_the_image(head, fap_frame):
     face, renderer = head
     centres = renderer.project(np.vstack([face.pivots["eye_l"], face.pivots["eye_r"]]))
 
@@ -51,22 +44,22 @@ def test_eyes_turned_left_move_the_iris_right_in_the_image(head):
             xs.append(np.nonzero(dark)[1].mean() + c0)
         return float(np.mean(xs))
 
-    x0 = iris_x(renderer.frame(face.deform_frame(_faps())))
-    x_left = iris_x(renderer.frame(face.deform_frame(_faps(f23=40000, f24=40000))))
-    x_right = iris_x(renderer.frame(face.deform_frame(_faps(f23=-40000, f24=-40000))))
+    x0 = iris_x(renderer.frame(face.deform_frame(fap_frame())))
+    x_left = iris_x(renderer.frame(face.deform_frame(fap_frame(f23=40000, f24=40000))))
+    x_right = iris_x(renderer.frame(face.deform_frame(fap_frame(f23=-40000, f24=-40000))))
     # FAP 23/24 positive turns the eyes to the face's own left, the image's right
     assert x_left > x0 + 1.5
     assert x_right < x0 - 1.5
 
 
-def test_open_mouth_close_up_shows_a_dark_cavity_not_the_background():
+def test_open_mouth_close_up_shows_a_dark_cavity_not_the_background(fap_frame):
     """Framing the mouth alone must not clip the cavity behind it (the far plane follows
     the whole head), and the cavity is painted dark."""
     face = engine.load_face(None)
     fp = face.feature_points
     mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "8.1", "2.1")]]
     with FaceRenderer(face, width=W, height=H, framing=mouth) as renderer:
-        moved = face.deform_frame(_faps(f3=900))
+        moved = face.deform_frame(fap_frame(f3=900))
         image = renderer.frame(moved).astype(int)
         background = np.asarray(renderer.look.background) * 255
         # the opening: between the lip midpoints, inward of the corners
@@ -106,17 +99,17 @@ def test_resting_and_bilabial_lips_hide_the_teeth():
                 assert teeth < 60
 
 
-def test_closed_lids_cover_the_whole_eye():
+def test_closed_lids_cover_the_whole_eye(fap_frame):
     """A blink hides the sclera right into the corners (white pixels of a close-up)."""
     face = engine.load_face(None)
     fp = face.feature_points
     lids = face.vertices[[fp[k] for k in ("3.1", "3.2", "3.3", "3.4")]]
     side = np.array([0.012, 0.0, 0.0])
     around = np.vstack([lids + side, lids - side])
-    closed = _faps(f19=1024, f20=1024)
+    closed = fap_frame(f19=1024, f20=1024)
     with FaceRenderer(face, width=400, height=150, framing=around) as renderer:
         white = []
-        for values in (_faps(), closed):
+        for values in (fap_frame(), closed):
             image = renderer.frame(face.deform_frame(values)).astype(int)
             white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
     assert white[0] > 500

@@ -9,8 +9,8 @@ import pytest
 from facelib import read_fap
 from facelib.cli import main
 
-ROOT = Path(__file__).parent.parent
-SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
+ROOT = Path(__file__).parents[2]
+SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 
 
 @pytest.fixture(autouse=True)

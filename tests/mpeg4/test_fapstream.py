@@ -6,10 +6,10 @@ import pytest
 from facelib import FapStream, FapTrack, ParameterError
 
 
-def _ramp(n=10, fps=25.0):
-    values = np.zeros((n, 84), np.float32)
-    values[:, 2] = np.arange(n) * 10.0  # open_jaw
-    return FapStream(fps, values)
+@pytest.fixture
+def ramp(fap_stream):
+    """``ramp(n, fps)``: open_jaw rising 10 FAP units per frame from 0."""
+    return lambda n=10, fps=25.0: fap_stream(n, fps=fps, open_jaw=np.arange(n) * 10.0)
 
 
 def test_arrays_are_copied_read_only_and_typed():
@@ -60,8 +60,8 @@ def test_unmasked_values_are_zeroed():
     assert stream.active_faps() == (3,)
 
 
-def test_duration_times_and_slicing():
-    stream = _ramp(10, 25)
+def test_duration_times_and_slicing(ramp):
+    stream = ramp(10, 25)
     assert stream.duration == pytest.approx(0.4)
     assert stream.times[3] == pytest.approx(0.12)
     part = stream[2:5]
@@ -73,8 +73,8 @@ def test_duration_times_and_slicing():
         stream[3]
 
 
-def test_resample_interpolates_linearly_and_keeps_duration():
-    stream = _ramp(10, 25)
+def test_resample_interpolates_linearly_and_keeps_duration(ramp):
+    stream = ramp(10, 25)
     doubled = stream.resample(50)
     assert doubled.n_frames == 20
     assert doubled.duration == pytest.approx(stream.duration)
@@ -84,20 +84,20 @@ def test_resample_interpolates_linearly_and_keeps_duration():
     assert back == stream
 
 
-def test_concat_and_equality():
-    a, b = _ramp(4), _ramp(3)
+def test_concat_and_equality(ramp):
+    a, b = ramp(4), ramp(3)
     joined = FapStream.concat([a, b])
     assert joined.n_frames == 7
     assert joined[:4] == a and joined[4:] == b
     assert a != b
     with pytest.raises(ParameterError, match="fps"):
-        FapStream.concat([a, _ramp(3, 30)])
+        FapStream.concat([a, ramp(3, 30)])
 
 
-def test_high_level_fields_follow_slicing_and_concat():
+def test_high_level_fields_follow_slicing_and_concat(ramp):
     viseme = np.tile([1, 2, 32, 0], (4, 1))
     a = FapStream(25, np.zeros((4, 84)), viseme=viseme)
-    joined = FapStream.concat([a, _ramp(2)])
+    joined = FapStream.concat([a, ramp(2)])
     assert joined.viseme.shape == (6, 4)
     assert joined.viseme[:4].tolist() == viseme.tolist()
     assert not joined.viseme[4:].any()

@@ -9,7 +9,7 @@ import pytest
 import facelib
 from facelib.cli import main
 
-ROOT = Path(__file__).parent.parent
+ROOT = Path(__file__).parents[2]
 
 
 def test_version(capsys):

@@ -1,0 +1,148 @@
+"""Bad arguments to the public API raise the facelib error that names the mistake.
+
+One table: a public call with a bad argument, the facelib error it must raise and a
+fragment of the message. No bare built-in exception (ZeroDivisionError, TypeError from
+numpy, a raw OSError, ...) may escape instead.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import facelib
+from facelib import expressions, fdl, gaze, sync, visemes
+from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, VisemeCue
+from facelib.errors import (
+    DataError,
+    FacelibError,
+    FapFormatError,
+    FdlError,
+    FileError,
+    ParameterError,
+    SpeechError,
+)
+from facelib.mpeg4 import FapStream, FapTrack, read_fap, write_fap
+
+JOY = [ExpressionCue("joy", 0, 1000)]
+SAID = SpeechSpec(visemes=(VisemeCue("A", 0, 200),))
+STREAM = FapStream(25, np.zeros((2, 84), np.float32))
+EMPTY = FapTrack.empty(2, fps=25)
+
+
+def _a_file(tmp: Path) -> Path:
+    """A plain file, so that ``file / "x"`` is a path whose folder cannot be made."""
+    path = tmp / "not_a_folder"
+    path.write_text("x")
+    return path
+
+
+# (id, call(tmp_path), error, message fragment)
+CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
+    # frame rates, counts and seeds: the shared checks
+    ("expressions fps 0", lambda _: expressions.animate(JOY, fps=0, n_frames=5),
+     ParameterError, "fps must be a positive number"),
+    ("expressions fps nan", lambda _: expressions.animate(JOY, fps=float("nan"), n_frames=5),
+     ParameterError, "fps must be a positive number"),
+    ("expressions n_frames -1", lambda _: expressions.animate(JOY, fps=25, n_frames=-1),
+     ParameterError, "n_frames must be an integer >= 0"),
+    ("expressions n_frames 2.5", lambda _: expressions.animate(JOY, fps=25, n_frames=2.5),
+     ParameterError, "n_frames must be an integer"),
+    ("visemes fps -25", lambda _: visemes.animate(SAID, fps=-25),
+     ParameterError, "fps must be a positive number"),
+    ("visemes fps str", lambda _: visemes.animate(SAID, fps="25"),
+     ParameterError, "fps must be a positive number"),
+    ("visemes rate 0", lambda _: visemes.animate(SAID, fps=25, rate=0),
+     ParameterError, "rate must be a finite number in [0.25, 4]"),
+    ("text rate 10", lambda _: visemes.timeline_from_text("hello", rate=10),
+     ParameterError, "rate must be a finite number in [0.25, 4]"),
+    ("gaze seed -1", lambda _: gaze.animate([], fps=25, n_frames=5, seed=-1),
+     ParameterError, "seed must be an integer from 0 to 2^63-1"),
+    ("gaze seed 1.5", lambda _: gaze.animate([], fps=25, n_frames=5, seed=1.5),
+     ParameterError, "seed must be an integer"),
+    ("gaze fps 0", lambda _: gaze.animate([], fps=0, n_frames=5, seed=0),
+     ParameterError, "fps must be a positive number"),
+    ("gaze simulate seconds 0", lambda _: gaze.simulate("default", seconds=0),
+     ParameterError, "seconds must be a finite number in (0, inf]"),
+    ("gaze pursue shape", lambda _: gaze.pursue(np.zeros((4, 3)), fps=25),
+     ParameterError, "target_deg must be a finite (n_frames, 2) array"),
+    ("sync seed bool", lambda _: sync.combine(expressions=EMPTY, visemes=EMPTY, gaze=EMPTY,
+                                              seed=True),
+     ParameterError, "seed must be an integer"),
+    ("sync blinks without lids", lambda _: sync.combine(
+        expressions=EMPTY, visemes=EMPTY, gaze=EMPTY, blinks=np.zeros(2)),
+     ParameterError, "blinks need blink_lids"),
+    ("animate seed -3", lambda _: facelib.animate(fdl.loads('show { "joy", dur = 1 }'), seed=-3),
+     ParameterError, "seed must be an integer"),
+    ("timeline fps 0", lambda _: visemes.timeline_to_sentence(
+        visemes.timeline_from_text("hi"), fps=0),
+     ParameterError, "fps must be a positive number"),
+    # streams and tracks
+    ("stream shape", lambda _: FapStream(25, np.zeros((2, 80))),
+     ParameterError, "values must have shape (n_frames, 84)"),
+    ("stream fps inf", lambda _: FapStream(float("inf"), np.zeros((2, 84))),
+     ParameterError, "fps must be a positive number"),
+    # names: one "did you mean"
+    ("FAP name", lambda _: facelib.fap("open_jaww"),
+     ParameterError, "did you mean 'open_jaw'"),
+    ("FAP id 99", lambda _: facelib.fap(99), ParameterError, "outside 1-84"),
+    ("expression misspelt", lambda _: expressions.animate(
+        [ExpressionCue("joyy", 0, 1000, origin=("story.fdl", 3))], fps=25, n_frames=5),
+     FdlError, "story.fdl:3: unknown expression 'joyy'; did you mean 'joy'?"),
+    ("eye behaviour misspelt", lambda _: gaze.animate(
+        [GazeCue("lookto", ("left", 10.0, "yes"), 0, 500, origin=("s.fdl", 2))],
+        fps=25, n_frames=5, seed=0),
+     FdlError, "did you mean 'lookTo'"),
+    ("storyboard function misspelt", lambda _: fdl.loads('shwo { "joy", dur = 1 }'),
+     FdlError, "did you mean 'show'"),
+    ("storyboard field misspelt", lambda _: fdl.loads('show { "joy", dur = 1, intensty = 1 }'),
+     FdlError, "did you mean 'intensity'"),
+    # files: OSError wrapped with the path
+    ("write_fap into a file", lambda tmp: write_fap(STREAM, _a_file(tmp) / "x.fap"),
+     FileError, "not_a_folder/x.fap: cannot write"),
+    ("write_timeline into a file", lambda tmp: visemes.write_timeline(
+        visemes.timeline_from_text("hi"), _a_file(tmp) / "t.json"),
+     FileError, "cannot write"),
+    ("read_fap missing", lambda tmp: read_fap(tmp / "nothing.fap"),
+     FapFormatError, "nothing.fap"),
+    ("write_fap dialect", lambda tmp: write_fap(STREAM, tmp / "x.fap", dialect="mpeg"),
+     ParameterError, "unknown .fap dialect 'mpeg'"),
+    ("write_fap fps 24.5", lambda tmp: write_fap(STREAM.resample(24.5), tmp / "x.fap"),
+     ParameterError, "whole frame rate"),
+    ("sync rules missing", lambda tmp: sync.SyncRules.load(tmp / "none.json"),
+     FileError, "none.json: cannot read"),
+    ("sync rules not JSON", lambda tmp: sync.SyncRules.load(_write(tmp, "r.json", "{")),
+     DataError, "r.json:1: invalid JSON"),
+    ("sync rules malformed", lambda tmp: sync.SyncRules.load(_write(tmp, "r.json", "{}")),
+     DataError, "bad synchronizer rules"),
+    ("storyboard missing", lambda tmp: fdl.load(tmp / "none.fdl"),
+     FdlError, "not found"),
+    ("face missing", lambda tmp: facelib.load_face(tmp / "none.json"),
+     facelib.FaceModelError, "cannot read face definition"),
+    ("speech without content", lambda _: visemes.animate(SpeechSpec(), fps=25),
+     SpeechError, "neither audio, text nor a viseme script"),
+]
+
+
+def _write(tmp: Path, name: str, text: str) -> Path:
+    path = tmp / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(("call", "error", "fragment"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_bad_input_raises_the_facelib_error(tmp_path, call, error, fragment):
+    with pytest.raises(error) as info:
+        call(tmp_path)
+    assert fragment in str(info.value)
+    assert isinstance(info.value, FacelibError)
+
+
+def test_the_table_names_each_error_class():
+    named = {c[2] for c in CASES}
+    assert {ParameterError, FdlError, FileError, DataError, FapFormatError,
+            SpeechError} <= named
