@@ -9,8 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from facelib import FacelibError, FapFormatError, FapStream, ParameterError, read_fap, write_fap
-from facelib.errors import FileError
-from facelib.errors import FacelibWarning
+from facelib.errors import FacelibWarning, FileError
 from facelib.mpeg4 import DIALECTS, read_fap_file
 
 DATA = Path(__file__).parents[1] / "data" / "fap"
