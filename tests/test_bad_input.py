@@ -122,9 +122,21 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
      FdlError, "not found"),
     ("face missing", lambda tmp: facelib.load_face(tmp / "none.json"),
      facelib.FaceModelError, "cannot read face definition"),
+    ("deformer override of no region", lambda _: facelib.load_face(deformers={"mouth": "rbf"}),
+     ParameterError, "names no region or group"),
+    ("unknown deformer", lambda _: facelib.load_face(deformers={"lips": "spline"}),
+     facelib.FaceModelError, "unknown deformer 'spline'"),
+    ("evaluate unknown deformer", lambda _: _evaluate(("spline",)),
+     ParameterError, "unknown deformer 'spline'"),
     ("speech without content", lambda _: visemes.animate(SpeechSpec(), fps=25),
      SpeechError, "neither audio, text nor a viseme script"),
 ]
+
+
+def _evaluate(names: tuple[str, ...]) -> object:
+    from facelib.evaluate import evaluate_deformers
+
+    return evaluate_deformers(names)
 
 
 def _write(tmp: Path, name: str, text: str) -> Path:
