@@ -237,6 +237,12 @@ class Face:
             _steps=steps,
         )
 
+    def __repr__(self) -> str:
+        """One line: sizes and names, never the arrays."""
+        return (f"Face(vertices={len(self.vertices)}, triangles={len(self.triangles)}, "
+                f"parts=[{', '.join(self.parts)}], feature_points={len(self.feature_points)}, "
+                f"regions={len(self.regions)})")
+
     @property
     def n_vertices(self) -> int:
         return int(self.vertices.shape[0])

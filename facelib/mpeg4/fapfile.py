@@ -51,7 +51,7 @@ from facelib.mpeg4.stream import (
 )
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
-__all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
+__all__ = ["DIALECTS", "FapFile", "format_fap", "read_fap", "read_fap_file", "write_fap"]
 
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
@@ -407,14 +407,22 @@ def write_fap(
 
     Returns the path written.
     """
+    path = Path(path)
+    text = format_fap(stream, dialect=dialect, name=name if name is not None else path.stem)
+    write_text_atomic(path, text)
+    return path
+
+
+def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "facelib") -> str:
+    """The text of a ``.fap`` file holding ``stream`` (see :func:`write_fap` for
+    ``dialect``); ``name`` goes into the header, spaces becoming underscores."""
     if dialect not in DIALECTS:
         raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
     _check_range(stream)
-    path = Path(path)
-    label = "_".join((name if name is not None else path.stem).split()) or "facelib"
+    label = "_".join(name.split()) or "facelib"
     width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
     values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
@@ -439,8 +447,7 @@ def write_fap(
             else:
                 tokens.append(values[i * N_FAPS + slot])
         out.append(sep.join(tokens))
-    write_text_atomic(path, "\n".join(out) + "\n")
-    return path
+    return "\n".join(out) + "\n"
 
 
 def _decimal(value: float) -> str:
