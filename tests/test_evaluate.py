@@ -79,7 +79,7 @@ def test_cli_writes_the_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     status = main(["evaluate", "-o", str(tmp_path), "--deformers", "rbf,inverse_distance",
                    "--poses", "expression", "--no-sheet"])
     assert status == 0
-    assert (tmp_path / "deformers.csv").exists() and "wrote" in capsys.readouterr().out
+    assert (tmp_path / "deformers.csv").exists() and "wrote" in capsys.readouterr().err
     assert main(["evaluate", "-o", str(tmp_path), "--deformers", "nope", "--no-sheet"]) == 1
 
 
