@@ -39,6 +39,7 @@ LIP_POINTS = ("2.2", "2.3", "2.4", "2.5", "2.6", "2.7", "2.8", "2.9",
 """The 18 MPEG-4 lip feature points (the seed used 18 CANDIDE lip vertices); a face that
 lacks some (the default head has no 8.9, 8.10) reports the others."""
 
+POSE_KINDS = ("viseme", "expression", "syllable")
 SYLLABLE_STEPS = (0.0, 0.5, 1.0)
 """Frames of a syllable: the consonant, half-way, the vowel (weights of the vowel)."""
 
@@ -68,6 +69,9 @@ def _syllables() -> list[tuple[str, str, str]]:
 
 def evaluation_poses(kinds: Sequence[str] = ("viseme", "expression", "syllable")) -> list[Pose]:
     """The default poses: 15 visemes and 6 expressions at full intensity, 27 syllables."""
+    unknown = [k for k in kinds if k not in POSE_KINDS]
+    if unknown or not kinds:
+        raise ParameterError(f"pose kinds must be some of {POSE_KINDS}, got {tuple(kinds)}")
     from facelib.expressions.library import default_library
     from facelib.mpeg4.visemes import viseme_id, viseme_names
     from facelib.visemes.tables import viseme_targets

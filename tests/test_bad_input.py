@@ -129,6 +129,8 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
      facelib.FaceModelError, "unknown deformer 'spline'"),
     ("evaluate unknown deformer", lambda _: _evaluate(("spline",)),
      ParameterError, "unknown deformer 'spline'"),
+    ("evaluate unknown pose kind", lambda _: _poses(("visemes",)),
+     ParameterError, "pose kinds must be some of"),
     ("speech without content", lambda _: visemes.animate(SpeechSpec(), fps=25),
      SpeechError, "neither audio, text nor a viseme script"),
     ("setup_face mesh format", lambda tmp: facelib.setup_face(tmp / "head.fbx", landmarks={}),
@@ -148,6 +150,12 @@ def _evaluate(names: tuple[str, ...]) -> object:
     from facelib.evaluate import evaluate_deformers
 
     return evaluate_deformers(names)
+
+
+def _poses(kinds: tuple[str, ...]) -> object:
+    from facelib.evaluate import evaluation_poses
+
+    return evaluation_poses(kinds)
 
 
 def _write(tmp: Path, name: str, text: str) -> Path:
