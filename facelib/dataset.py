@@ -128,10 +128,8 @@ _SECTIONS = {
 }
 
 
-def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
-    """Read a dataset spec (TOML); unknown keys and bad values raise FacelibError naming
-    the file."""
-    where = str(path)
+def _read_spec(path: str | os.PathLike[str], where: str) -> dict[str, Any]:
+    """The spec's TOML table, its keys and sections checked against the known ones."""
     try:
         raw = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     except OSError as exc:
@@ -145,6 +143,14 @@ def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
                                f"{sorted(_TOP_KEYS | set(_SECTIONS))}", path=where)
         if allowed is not None and (not isinstance(value, dict) or set(value) - allowed):
             raise FacelibError(f"[{key}] takes {sorted(allowed)}, got {value!r}", path=where)
+    return raw
+
+
+def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
+    """Read a dataset spec (TOML); unknown keys and bad values raise FacelibError naming
+    the file."""
+    where = str(path)
+    raw = _read_spec(path, where)
     options: dict[str, Any] = {k: raw[k] for k in _TOP_KEYS if k in raw}
     expressions = raw.get("expressions", {})
     if "names" in expressions:

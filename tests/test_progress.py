@@ -41,8 +41,9 @@ def test_a_bar_redrawn_in_place_on_a_terminal():
 
 
 def test_progress_argument():
-    assert progress_callback(None, "x") is None and progress_callback(False, "x") is None
-    assert isinstance(progress_callback(True, "x"), ConsoleProgress)
+    assert progress_callback(None, "x") is None
+    assert progress_callback(progress=False, label="x") is None
+    assert isinstance(progress_callback(progress=True, label="x"), ConsoleProgress)
     seen = []
     assert progress_callback(lambda d, t: seen.append(d), "x") is not None
     with pytest.raises(ParameterError, match="progress must be"):

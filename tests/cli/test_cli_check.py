@@ -13,8 +13,8 @@ BAD = [
     ('look { "lookAt", dur = 1 }', 2, "unknown eye behaviour 'lookAt'"),
     ('look { "lookTo", "left", 15.0, "yes", 3, 4, dur = 1 }', 2, "lookTo takes at most 3"),
     ('look { "lookTo", "sideways", 15.0, "yes", dur = 1 }', 2, "unknown direction 'sideways'"),
-    ('define_gaze { "nervous", like = "default", blink_rate = 0.6 }\n'
-     'look { "nervous", dur = 3 }', 2, "eye behaviour 'nervous': unknown key"),
+    (('define_gaze { "nervous", like = "default", blink_rate = 0.6 }\n'
+      'look { "nervous", dur = 3 }'), 2, "eye behaviour 'nervous': unknown key"),
 ]
 
 
