@@ -121,4 +121,6 @@ class _Copier:
             gaps = [i for i in range(1, n + 4) if i not in numbered][:3]
             raise self.fail(f"table has holes in its list part (missing positions {gaps})", here)
         items = tuple(numbered[i] for i in range(1, n + 1))
-        return LuaTable(items=items, fields=named, line=here if own is not None else None)
+        # named fields in name order: Lua's hash order changes from state to state
+        return LuaTable(items=items, fields=dict(sorted(named.items())),
+                        line=here if own is not None else None)

@@ -83,7 +83,7 @@ def merge_behaviours(
     for name, spec in (overrides or {}).items():
         if not isinstance(spec, Mapping):
             raise FdlError(f"eye behaviour {name!r} must be a table, got {spec!r}")
-        for key in sorted(spec, key=str):  # sorted: Lua tables iterate in no fixed order
+        for key in spec:
             if key not in _BEHAVIOUR_KEYS and key not in PARAM_KEYS:
                 raise FdlError(
                     f"eye behaviour {name!r}: unknown key {key!r}"
