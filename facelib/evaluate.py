@@ -39,6 +39,7 @@ LIP_POINTS = ("2.2", "2.3", "2.4", "2.5", "2.6", "2.7", "2.8", "2.9",
 """The 18 MPEG-4 lip feature points (the seed used 18 CANDIDE lip vertices); a face that
 lacks some (the default head has no 8.9, 8.10) reports the others."""
 
+POSE_KINDS = ("viseme", "expression", "syllable")
 SYLLABLE_STEPS = (0.0, 0.5, 1.0)
 """Frames of a syllable: the consonant, half-way, the vowel (weights of the vowel)."""
 
@@ -68,6 +69,9 @@ def _syllables() -> list[tuple[str, str, str]]:
 
 def evaluation_poses(kinds: Sequence[str] = ("viseme", "expression", "syllable")) -> list[Pose]:
     """The default poses: 15 visemes and 6 expressions at full intensity, 27 syllables."""
+    unknown = [k for k in kinds if k not in POSE_KINDS]
+    if unknown or not kinds:
+        raise ParameterError(f"pose kinds must be some of {POSE_KINDS}, got {tuple(kinds)}")
     from facelib.expressions.library import default_library
     from facelib.mpeg4.visemes import viseme_id, viseme_names
     from facelib.visemes.tables import viseme_targets
@@ -193,7 +197,8 @@ def summary_table(ev: Evaluation) -> list[dict[str, Any]]:
 
 def _markdown(ev: Evaluation) -> str:
     table = summary_table(ev)
-    ranked = sorted(table, key=lambda r: r["syllables_mean"])
+    key = "syllables_mean" if not np.isnan(table[0]["syllables_mean"]) else "visemes_mean"
+    ranked = sorted(table, key=lambda r: r[key])
     lines = [
         ("| rank | deformer | visemes mean | visemes var | expressions mean | syllables mean "
          "| syllables var | worst viseme / rbf | max flipped | linearised vs exact (mm) |"),
@@ -207,24 +212,28 @@ def _markdown(ev: Evaluation) -> str:
             f"{r['syllables_var']:.3g} | {r['worst_viseme_ratio']:.3f} | {r['max_flipped']} "
             f"| {lin} |")
     lines.append("")
-    lines.append(f"Lip region at rest: {ev.rest:.5f}. Ranked by the syllables' mean, as the "
-                 "seed's table E.1.")
+    what = "syllables'" if key == "syllables_mean" else "visemes'"
+    lines.append(f"Lip region at rest: {ev.rest:.5f}. Ranked by the {what} mean (the seed's "
+                 "table E.1 ranks by the syllables').")
     return "\n".join(lines) + "\n"
 
 
 def write_evaluation(ev: Evaluation, folder: str | Path, *, sheet: bool = True,
-                     stem: str = "deformers", face_path: str | Path | None = None
-                     ) -> list[Path]:
-    """Write ``<stem>.csv`` (every pose), ``<stem>.md`` (the summary), ``<stem>_frames.csv``
-    (the seed's per-frame rows) and, with ``sheet``, ``<stem>_mouths.png``. Returns paths."""
+                     frames: bool = True, stem: str = "deformers",
+                     face_path: str | Path | None = None) -> list[Path]:
+    """Write ``<stem>.csv`` (every pose), ``<stem>.md`` (the summary), with ``frames``
+    ``<stem>_frames.csv`` (the seed's per-frame rows) and with ``sheet``
+    ``<stem>_mouths.png``. Returns the paths written."""
     folder = Path(folder)
-    out = [folder / f"{stem}.csv", folder / f"{stem}.md", folder / f"{stem}_frames.csv"]
+    out = [folder / f"{stem}.csv", folder / f"{stem}.md"]
     write_text_atomic(out[0], _csv(("deformer", "kind", "pose", "mean", "min", "max",
                                     "flipped"), ev.rows))
     write_text_atomic(out[1], _markdown(ev))
-    frames = [(name, *row) for name, rows in ev.reports.items() for row in rows]
-    write_text_atomic(out[2], _csv(("deformer", "frame", "time_s", "point", "min", "max",
-                                    "mean"), frames))
+    if frames:
+        out.append(folder / f"{stem}_frames.csv")
+        rows = [(name, *row) for name, report in ev.reports.items() for row in report]
+        write_text_atomic(out[-1], _csv(("deformer", "frame", "time_s", "point", "min", "max",
+                                         "mean"), rows))
     if sheet:
         out.append(folder / f"{stem}_mouths.png")
         write_contact_sheet(list(dict.fromkeys(r[0] for r in ev.rows)), out[-1],

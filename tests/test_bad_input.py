@@ -123,6 +123,14 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
      FdlError, "not found"),
     ("face missing", lambda tmp: facelib.load_face(tmp / "none.json"),
      facelib.FaceModelError, "cannot read face definition"),
+    ("deformer override of no region", lambda _: facelib.load_face(deformers={"mouth": "rbf"}),
+     ParameterError, "names no region or group"),
+    ("unknown deformer", lambda _: facelib.load_face(deformers={"lips": "spline"}),
+     facelib.FaceModelError, "unknown deformer 'spline'"),
+    ("evaluate unknown deformer", lambda _: _evaluate(("spline",)),
+     ParameterError, "unknown deformer 'spline'"),
+    ("evaluate unknown pose kind", lambda _: _poses(("visemes",)),
+     ParameterError, "pose kinds must be some of"),
     ("speech without content", lambda _: visemes.animate(SpeechSpec(), fps=25),
      SpeechError, "neither audio, text nor a viseme script"),
     ("setup_face mesh format", lambda tmp: facelib.setup_face(tmp / "head.fbx", landmarks={}),
@@ -136,6 +144,18 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
         CARTOON, landmarks=CARTOON.with_name("cartoon_landmarks.json"), unit="km"),
      ParameterError, "unit 'km' is not one of"),
 ]
+
+
+def _evaluate(names: tuple[str, ...]) -> object:
+    from facelib.evaluate import evaluate_deformers
+
+    return evaluate_deformers(names)
+
+
+def _poses(kinds: tuple[str, ...]) -> object:
+    from facelib.evaluate import evaluation_poses
+
+    return evaluation_poses(kinds)
 
 
 def _write(tmp: Path, name: str, text: str) -> Path:

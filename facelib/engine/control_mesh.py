@@ -2,8 +2,10 @@
 
 Peña Araya's deformers are driven by the triangles of a coarse control mesh (CANDIDE-3 in the
 seed, section 1.2). facelib's regions name their feature points and static anchors, so the
-control mesh is the Delaunay triangulation of those sources in their best-fit plane (the
-face looks along +z, so for the lips and brows this is the front view). Anchors move by zero,
+control mesh is the Delaunay triangulation of those sources seen from the front (facelib's
+face frame looks along +z). A best-fit plane would be wrong here: the lips and their anchors
+wrap around the face, so their least-spread direction is vertical and a fit would look at
+them from above, stacking the lips. Anchors move by zero,
 which keeps the region's border still.
 """
 
@@ -65,22 +67,26 @@ class ControlMesh:
         return best.astype(np.int64), lam[np.arange(len(flat)), best], inside
 
 
-def control_mesh(controls: np.ndarray, anchors: np.ndarray) -> ControlMesh:
-    """Delaunay triangulation of ``controls (N, 3)`` + ``anchors (A, 3)`` in their best-fit
-    plane. Raises ``FaceModelError`` for fewer than three sources or a degenerate set."""
+def control_mesh(controls: np.ndarray, anchors: np.ndarray, *,
+                 view: tuple[float, float, float] = (0.0, 0.0, 1.0)) -> ControlMesh:
+    """Delaunay triangulation of ``controls (N, 3)`` + ``anchors (A, 3)`` projected along
+    ``view`` (the face's +z by default). Raises ``FaceModelError`` for fewer than three
+    sources or a set that is collinear in that projection."""
     sources = np.concatenate([np.asarray(controls, np.float64),
                               np.asarray(anchors, np.float64).reshape(-1, 3)])
     if len(sources) < 3:
         raise FaceModelError("a control mesh needs at least three feature points or anchors")
     if len(cKDTree(sources).query_pairs(0.0)):
         raise FaceModelError("a control mesh's feature points and anchors must be distinct")
-    centred = sources - sources.mean(axis=0)
-    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
+    normal = np.asarray(view, np.float64) / np.linalg.norm(view)
+    helper = np.array([0.0, 1.0, 0.0]) if abs(normal[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(helper, normal)
+    u /= np.linalg.norm(u)
+    axes = np.stack([u, np.cross(normal, u), normal])
+    flat = sources @ axes[:2].T
+    _, sv, _ = np.linalg.svd(flat - flat.mean(axis=0), full_matrices=False)
     if sv[1] <= 1e-9 * max(sv[0], 1e-300):
         raise FaceModelError("the feature points and anchors of a control mesh are collinear")
-    normal = vt[2] if vt[2] @ np.array([0.0, 0.0, 1.0]) >= 0 else -vt[2]
-    u = vt[0]
-    axes = np.stack([u, np.cross(normal, u), normal])
     tri = Delaunay(sources @ axes[:2].T)
     triangles = tri.simplices.astype(np.int64)
     edges = np.linalg.norm(sources[triangles] - sources[np.roll(triangles, 1, axis=1)], axis=2)

@@ -4,8 +4,10 @@ Deformation of one frame ``f`` (84 FAP values):
 
 1. every translational FAP moves its feature point by ``f_j * FAPU_j * direction_j``
    (eq. 4.6) and the regions controlled by that point carry the motion to their vertices
-   (raised cosine, RBF or explicit weights); all of this is one sparse linear operator
-   ``A (84, 3V)``, so ``positions = rest + f @ A``;
+   (each region's deformer from :mod:`facelib.engine.registry`: raised cosine, RBF,
+   explicit weights, the second seed's interpolations); all of this is one sparse linear
+   operator ``A (84, 3V)``, so ``positions = rest + f @ A``, plus the exact per-frame step of
+   any frame-based region in ``mode="exact"``;
 2. eyelids (FAP 19-22) rotate over the eyeball about the eye centre, by the angle that
    moves their feature point vertically by ``f_j * IRISD``, each vertex by its weight;
 3. eyeballs rotate about their centres (FAP 23-26) and move forward (FAP 27-28);

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -70,29 +71,61 @@ class FrameMap:
         n = dc.shape[0]
         moved = np.broadcast_to(self.mesh.sources, (n, *self.mesh.sources.shape)).copy()
         moved[:, : self.n_controls] += dc
-        rest_pos = self._place(np.broadcast_to(self.mesh.sources, moved.shape))
-        new_pos = self._place(moved)
-        blend = sp.csr_array((self.u, (self.member, np.arange(self.u.size))),
-                             shape=(self.n_members, self.u.size))
-        diff = (new_pos - rest_pos).transpose(1, 0, 2).reshape(self.u.size, -1)
-        return np.asarray(blend @ diff).reshape(self.n_members, n, 3).transpose(1, 0, 2)
+        return self._blend(moved) - self._rest
 
-    def _place(self, sources: np.ndarray) -> np.ndarray:
-        """``(n, S, 3) -> (n, K, 3)`` the pairs' members placed in the triangles' frames."""
+    @cached_property
+    def _variant(self) -> np.ndarray:
+        """(K,) int64 frame variant of each pair (see :func:`_all_frames`)."""
+        return np.where(self.zone == BASE, 0,
+                        np.where(self.zone == EDGE, 1 + self.corner, 4 + self.corner))
+
+    @cached_property
+    def _linear_parts(self) -> tuple[sp.csr_array, sp.csr_array]:
+        """Sparse ``O (Vr, 3T)`` and ``L (Vr, 21T)``: for pairs outside corner zones the
+        blended position is ``O @ corners + L @ frames`` (both flattened by rows), so a frame
+        costs two sparse products instead of a loop over the pairs."""
+        keep = self.zone != CORNER
+        t = self.tri[keep]
+        n_tri = len(self.mesh.triangles)
+        origin = sp.csr_array((self.u[keep], (self.member[keep], t * 3 + self.corner[keep])),
+                              shape=(self.n_members, 3 * n_tri))
+        rows = np.repeat(self.member[keep], 3)
+        cols = ((t * 7 + self._variant[keep])[:, None] * 3 + np.arange(3)).ravel()
+        vals = (self.u[keep, None] * self.local[keep]).ravel()
+        frames = sp.csr_array((vals, (rows, cols)), shape=(self.n_members, 21 * n_tri))
+        return origin, frames
+
+    @cached_property
+    def _rest(self) -> np.ndarray:
+        """(1, Vr, 3) the blended rest positions (the members, up to rounding)."""
+        return self._blend(self.mesh.sources[None])
+
+    def _blend(self, sources: np.ndarray) -> np.ndarray:
+        """``(n, S, 3) -> (n, Vr, 3)`` the members placed in every weighted frame, blended."""
+        n = len(sources)
         corners = sources[:, self.mesh.triangles]  # (n, T, 3, 3)
-        variant = np.where(self.zone == BASE, 0,
-                           np.where(self.zone == EDGE, 1 + self.corner, 4 + self.corner))
-        frames = _all_frames(corners)[:, self.tri, variant]  # (n, K, 3, 3)
-        origin = corners[:, self.tri, self.corner]  # (n, K, 3)
-        local = np.broadcast_to(self.local, (len(sources), *self.local.shape)).copy()
-        corner = self.zone == CORNER
-        if corner.any():
-            inplane = np.einsum("nkj,nkjc->nkc", local[:, corner, :2], frames[:, corner, :2])
+        frames = _all_frames(corners)  # (n, T, 7, 3, 3)
+        origin, linear = self._linear_parts
+        flat_c = corners.reshape(n, -1, 3).transpose(1, 0, 2).reshape(-1, n * 3)
+        flat_f = frames.reshape(n, -1, 3).transpose(1, 0, 2).reshape(-1, n * 3)
+        out = np.asarray(origin @ flat_c + linear @ flat_f)
+        out = out.reshape(self.n_members, n, 3).transpose(1, 0, 2)
+        corner = np.flatnonzero(self.zone == CORNER)
+        if corner.size:
+            tri, var = self.tri[corner], self._variant[corner]
+            f = frames[:, tri, var]  # (n, k, 3, 3)
+            local = np.broadcast_to(self.local[corner], (n, corner.size, 3)).copy()
+            inplane = np.einsum("nkj,nkjc->nkc", local[..., :2], f[:, :, :2])
             length = np.linalg.norm(inplane, axis=2)
             scale = np.divide(self.planar[corner], length, out=np.ones_like(length),
                               where=length > 0)
-            local[:, corner, :2] *= scale[..., None]
-        return origin + np.einsum("nkj,nkjc->nkc", local, frames)
+            local[..., :2] *= scale[..., None]
+            placed = corners[:, tri, self.corner[corner]] + np.einsum("nkj,nkjc->nkc", local, f)
+            blend = sp.csr_array((self.u[corner], (self.member[corner], np.arange(corner.size))),
+                                 shape=(self.n_members, corner.size))
+            summed = np.asarray(blend @ placed.transpose(1, 0, 2).reshape(corner.size, -1))
+            out += summed.reshape(self.n_members, n, 3).transpose(1, 0, 2)
+        return out
 
 
 def _all_frames(corners: np.ndarray) -> np.ndarray:

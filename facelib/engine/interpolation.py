@@ -99,39 +99,80 @@ def _surface_distances(setup: RegionSetup, nodes: np.ndarray, sources: np.ndarra
 def feature_point_weights(setup: RegionSetup) -> np.ndarray:
     """Kshirsagar's geometric interpolation (eq. 2.1-2.4) over surface distances.
 
-    Each vertex P is influenced by its nearest source FP1 (zone growth over the surface) and
-    the two neighbours FP2, FP3 of FP1 (sources whose zones touch) with the smallest angle at
-    FP1 between FP1->P and FP1->FPj, both below pi/2. Each influence i has its own reach
-    ``d_bar_i`` (eq. 2.3: the cosine-weighted mean of its surface distances to its chosen
-    neighbours), weight ``W_i`` (eq. 2.1) and ``M[P, i] = (W_i / d_i^2) / sum_j (W_j /
-    d_j^2)`` (eq. 2.4); at ``d_i = 0`` the row is ``e_i``. Returns (Vr, S) over all sources.
+    Zones grow over the surface from every source; sources whose zones touch are neighbours.
+    Seen from a vertex P, source i has the reach ``d_bar_i`` of eq. 2.3: the cosine-weighted
+    mean of its surface distances to the two neighbours at the smallest angles (at i,
+    between i->P and i->j) below pi/2. Its weight is ``W_i`` of eq. 2.1 and ``M[P, i] = (W_i /
+    d_i^2) / sum_j (W_j / d_j^2)`` (eq. 2.4); at ``d_i = 0`` the row is ``e_i``.
+
+    ``influences`` (a parameter) picks the sources that act on P: ``"zones"`` (default,
+    Kshirsagar's original) every source whose reach covers P; ``"nearest"`` (the seed's
+    implementation, section 3.3) P's nearest source and that source's two chosen neighbours.
+    Returns (Vr, S) over all sources; a vertex beyond every reach follows its nearest source.
     """
+    mode = setup.params.get("influences", "zones")
+    if mode not in ("zones", "nearest"):
+        raise setup.fail(f"feature_point influences must be 'zones' or 'nearest', got {mode!r}")
     sources = np.concatenate([setup.controls, setup.anchors])
     nodes = np.unique(np.concatenate([setup.members, sources]))
     dist = _surface_distances(setup, nodes, sources)  # (S, n)
-    local = np.searchsorted(nodes, setup.members)
-    pos = setup.vertices
     zone = dist.argmin(axis=0)  # nearest source of every node
     neighbours = _zone_neighbours(setup, nodes, zone, sources.size)
     d_src = dist[:, np.searchsorted(nodes, sources)]  # (S, S) surface distances
-    members = pos[setup.members]
-    src = pos[sources]
-    out = np.zeros((setup.members.size, sources.size))
-    for row, (p, node) in enumerate(zip(members, local, strict=True)):
-        first = int(zone[node])
-        chosen = _pick(p, first, neighbours[first], src)
-        influences = [first, *chosen]
-        d = dist[influences, node]
-        if d[0] == 0.0:
-            out[row, first] = 1.0
-            continue
-        reach = np.array([_reach(p, i, neighbours[i], src, d_src) for i in influences])
-        w = kshirsagar_weight(d, reach) / d**2
-        if not np.isfinite(w).all() or w.sum() <= 0:
-            out[row, first] = 1.0
-            continue
-        out[row, influences] = w / w.sum()
+    local = np.searchsorted(nodes, setup.members)
+    d = dist[:, local].T  # (Vr, S)
+    members = setup.vertices[setup.members]
+    src = setup.vertices[sources]
+    reach = np.zeros_like(d)
+    acting = np.zeros(d.shape, bool)
+    first = zone[local]
+    for i in range(sources.size):
+        reach[:, i], chosen = _reach_all(members, i, neighbours[i], src, d_src)
+        if mode == "nearest":
+            mine = first == i
+            acting[mine, i] = True
+            for column in chosen.T:
+                ok = mine & (column >= 0)
+                acting[ok, column[ok]] = True
+    if mode == "zones":
+        acting = np.isfinite(d)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = np.where(acting, kshirsagar_weight(d, reach) / d**2, 0.0)
+    total = w.sum(axis=1)
+    rows = np.arange(len(d))
+    out = np.zeros_like(d)
+    good = np.isfinite(total) & (total > 0) & (d[rows, first] > 0)
+    out[good] = w[good] / total[good, None]
+    out[~good, first[~good]] = 1.0  # on a source (d = 0: e_i), or beyond every reach
     return out
+
+
+def _reach_all(members: np.ndarray, i: int, candidates: np.ndarray, src: np.ndarray,
+               d_src: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``d_bar`` of eq. 2.3 for source i seen from every member, and the two neighbours
+    chosen for each (``(Vr,)`` float64, ``(Vr, 2)`` int64, -1 where none). With no neighbour
+    below pi/2 the reach is the nearest neighbour's distance (eq. 2.3 is undefined there)."""
+    n = len(members)
+    finite = d_src[i, candidates][np.isfinite(d_src[i, candidates])] if candidates.size else []
+    fallback = float(np.min(finite)) if len(finite) else 0.0
+    if not candidates.size:
+        return np.full(n, fallback), np.full((n, 2), -1, np.int64)
+    to_p = members - src[i]
+    to_j = src[candidates] - src[i]
+    norm = np.linalg.norm(to_p, axis=1)[:, None] * np.linalg.norm(to_j, axis=1)[None, :]
+    cos = np.divide(to_p @ to_j.T, norm, out=np.zeros((n, candidates.size)), where=norm > 0)
+    theta = np.arccos(np.clip(cos, -1.0, 1.0))
+    order = np.argsort(theta, axis=1, kind="stable")[:, :2]
+    picked = np.take_along_axis(theta, order, axis=1)
+    valid = picked < 0.5 * np.pi
+    weight = np.where(valid, np.cos(picked), 0.0)
+    dist = d_src[i, candidates[order]]
+    with np.errstate(invalid="ignore"):
+        total = np.where(valid, dist * weight, 0.0).sum(axis=1)
+    norm_w = weight.sum(axis=1)
+    reach = np.divide(total, norm_w, out=np.full(n, fallback), where=norm_w > 0)
+    chosen = np.where(valid, candidates[order], -1)
+    return reach, chosen
 
 
 def _zone_neighbours(setup: RegionSetup, nodes: np.ndarray, zone: np.ndarray, n: int
@@ -145,34 +186,6 @@ def _zone_neighbours(setup: RegionSetup, nodes: np.ndarray, zone: np.ndarray, n:
     adjacency = np.zeros((n, n), bool)
     adjacency[pairs[:, 0], pairs[:, 1]] = adjacency[pairs[:, 1], pairs[:, 0]] = True
     return [np.flatnonzero(adjacency[i]) for i in range(n)]
-
-
-def _angles(p: np.ndarray, i: int, candidates: np.ndarray, src: np.ndarray) -> np.ndarray:
-    to_p = p - src[i]
-    to_j = src[candidates] - src[i]
-    cos = (to_j @ to_p) / (np.linalg.norm(to_j, axis=1) * np.linalg.norm(to_p) + 1e-300)
-    return np.arccos(np.clip(cos, -1.0, 1.0))
-
-
-def _pick(p: np.ndarray, i: int, candidates: np.ndarray, src: np.ndarray) -> list[int]:
-    """The two neighbours of source i at the smallest angles below pi/2 (eq. 2.3)."""
-    if not candidates.size or np.allclose(p, src[i]):
-        return []
-    theta = _angles(p, i, candidates, src)
-    order = np.argsort(theta)
-    return [int(candidates[k]) for k in order[:2] if theta[k] < 0.5 * np.pi]
-
-
-def _reach(p: np.ndarray, i: int, candidates: np.ndarray, src: np.ndarray, d_src: np.ndarray
-           ) -> float:
-    """``d_bar`` of eq. 2.3 for source i seen from P; with no neighbour below pi/2, the
-    nearest neighbour's distance (the equation is undefined there)."""
-    chosen = _pick(p, i, candidates, src)
-    if not chosen:
-        finite = d_src[i, candidates][np.isfinite(d_src[i, candidates])] if candidates.size else []
-        return float(np.min(finite)) if len(finite) else 0.0
-    cos = np.cos(_angles(p, i, np.array(chosen), src))
-    return float((d_src[i, chosen] * cos).sum() / cos.sum())
 
 
 def barycentric_weights(setup: RegionSetup) -> np.ndarray:
@@ -232,7 +245,8 @@ DEFORMERS = (
         "Point Distance: normalised 1/(1 + d^p) weights of the sources (not interpolating)",
         "second seed eq. 3.4 with eq. 2.5-2.6", interpolating=False),
     Deformer(
-        "feature_point", lambda s: _controls_only(feature_point_weights(s), s), {},
+        "feature_point", lambda s: _controls_only(feature_point_weights(s), s),
+        {"influences": "zones"},
         "Kshirsagar's geometric interpolation over surface distances",
         "second seed eq. 2.1-2.4"),
     Deformer(

@@ -8,9 +8,11 @@ A triangle's roughness is the variance-weighted mean of its corners (eq. 3.3)::
     rho(T) = (G(v1) V(v1) + G(v2) V(v2) + G(v3) V(v3)) / (V(v1) + V(v2) + V(v3))
 
 Where the three variances are all zero (a flat or uniformly bent neighbourhood) the weighted
-mean is taken in its limit of equal weights, ``mean(G)``. A smooth face scores near 0; bumps,
-creases and folds raise it. The seed's test mesh scores 0 when flat, and 0.255 / 0.512 on
-average with a small / large bump (tables 4.3-4.4).
+mean is taken in its limit of equal weights, ``mean(G)``. A zero-area triangle has a zero
+normal, so each interior edge it shares scores ``rho_d = 1`` (a right angle); only edges with
+exactly two triangles count (boundary and non-manifold edges are skipped). A smooth face
+scores near 0; bumps, creases and folds raise it. The seed's test mesh scores 0 when flat,
+and 0.255 / 0.512 on average with a small / large bump (tables 4.3-4.4).
 """
 
 from __future__ import annotations

@@ -9,10 +9,13 @@ one solve serves every frame, every coordinate and every FAP. The same system wi
 ``phi(r) = r`` (or ``r^2 log r``) and an affine ``p`` is the thin-plate-spline warp of
 Orvalho's rig transfer, so both use :func:`interpolation_weights` and :func:`warp`.
 
-Kernels are scipy's :class:`~scipy.interpolate.RBFInterpolator` ones, plus
-``"multiquadric_eck"``: the per-source multiquadric of facelib's own thesis (eq. 4.8-4.10),
-``phi_j(r) = sqrt(r^2 + sc_j^2)`` with ``sc_j`` the distance from ``s_j`` to its nearest other
-source, which no single shape parameter expresses.
+Kernels are scipy's :class:`~scipy.interpolate.RBFInterpolator` ones, plus two that scipy
+lacks and facelib solves itself: ``"multiquadric_eck"``, the per-source multiquadric of
+facelib's own thesis (eq. 4.8-4.10), ``phi_j(r) = sqrt(r^2 + sc_j^2)`` with ``sc_j`` the
+distance from ``s_j`` to its nearest other source, which no single shape parameter
+expresses; and ``"wendland"``, Wendland's compactly supported C2 function ``phi(r) = (1 -
+r/rho)_+^4 (4 r/rho + 1)`` (positive definite in 3-D; one of the bases Jakobsson & Amoignon
+compare, second seed section 2.4.4) with support ``rho = 1 / epsilon``.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ __all__ = ["KERNELS", "interpolation_weights", "warp"]
 
 SCIPY_KERNELS = ("linear", "thin_plate_spline", "cubic", "quintic", "multiquadric",
                  "inverse_multiquadric", "inverse_quadratic", "gaussian")
-KERNELS = ("multiquadric_eck", *SCIPY_KERNELS)
+KERNELS = ("multiquadric_eck", "wendland", *SCIPY_KERNELS)
 """Kernel names accepted by :func:`interpolation_weights`."""
 
 _SHAPED = ("multiquadric", "inverse_multiquadric", "inverse_quadratic", "gaussian")
@@ -48,11 +51,21 @@ def _polynomial(points: np.ndarray, degree: int) -> np.ndarray:
     return np.hstack([np.ones((len(points), 1)), points])
 
 
-def _eck_weights(sources: np.ndarray, points: np.ndarray, degree: int,
-                 smoothing: float) -> np.ndarray:
-    sc = _nearest_other(sources)
-    h = np.sqrt(cdist(sources, sources) ** 2 + sc[None, :] ** 2)
-    hx = np.sqrt(cdist(points, sources) ** 2 + sc[None, :] ** 2)
+def _wendland(r: np.ndarray, support: float) -> np.ndarray:
+    t = np.clip(r / support, 0.0, 1.0)
+    return (1.0 - t) ** 4 * (4.0 * t + 1.0)
+
+
+def _own_weights(kernel: str, sources: np.ndarray, points: np.ndarray, *, degree: int,
+                 smoothing: float, support: float) -> np.ndarray:
+    """Solve the system of eq. 2.20-2.21 directly (kernels scipy does not have)."""
+    if kernel == "wendland":
+        h = _wendland(cdist(sources, sources), support)
+        hx = _wendland(cdist(points, sources), support)
+    else:
+        sc = _nearest_other(sources)
+        h = np.sqrt(cdist(sources, sources) ** 2 + sc[None, :] ** 2)
+        hx = np.sqrt(cdist(points, sources) ** 2 + sc[None, :] ** 2)
     if smoothing:
         h = h + smoothing * np.eye(len(sources))
     try:
@@ -88,6 +101,8 @@ def interpolation_weights(
     smoothing: >= 0; 0 interpolates, larger values approximate (scipy's ``smoothing``).
     epsilon: shape parameter of the shaped kernels (1 / length); None takes 1 / the median
         distance from a source to its nearest other source, so the result is unit-free.
+        For ``wendland`` the support is ``1 / epsilon``; None takes the largest distance
+        between two sources (every source then reaches every other).
 
     Returns
     -------
@@ -109,8 +124,10 @@ def interpolation_weights(
     gap = _nearest_other(src) if len(src) > 1 else np.zeros(1)
     if len(src) < 2 or not np.all(gap > 0):
         raise FaceModelError("RBF sources must be at least two distinct points")
-    if kernel == "multiquadric_eck":
-        return _eck_weights(src, pts, degree, smoothing)
+    if kernel in ("multiquadric_eck", "wendland"):
+        support = (float(cdist(src, src).max()) if epsilon is None else 1.0 / float(epsilon))
+        return _own_weights(kernel, src, pts, degree=degree, smoothing=smoothing,
+                            support=support)
     from scipy.interpolate import RBFInterpolator
 
     eps = 1.0 / float(np.median(gap)) if epsilon is None else float(epsilon)

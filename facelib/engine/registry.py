@@ -173,9 +173,6 @@ def _builtin() -> tuple[Deformer, ...]:
     )
 
 
-BUILTIN: tuple[Deformer, ...] = ()
-"""Filled below: the deformers facelib ships."""
-
 ALIASES = MappingProxyType({"cosine": "raised_cosine"})
 """Older names still accepted in face definitions."""
 
@@ -207,5 +204,6 @@ def _freeze(items: tuple[Deformer, ...]) -> Mapping[str, Deformer]:
     return MappingProxyType({d.name: d for d in items})
 
 
-BUILTIN = _builtin()
+BUILTIN: tuple[Deformer, ...] = _builtin()
+"""The deformers facelib ships, in registry order."""
 _REGISTRY = _freeze(BUILTIN)

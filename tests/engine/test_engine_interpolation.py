@@ -90,6 +90,16 @@ def test_l2_interpolation_at_controls(kind: str) -> None:
     assert deformer(kind).interpolating == (kind != "inverse_distance")
 
 
+def test_feature_point_seed_variant_uses_three_sources() -> None:
+    setup = _setup("feature_point", influences="nearest")
+    w = feature_point_weights(setup)
+    np.testing.assert_allclose(w.sum(axis=1), 1.0, atol=1e-12)
+    assert (np.count_nonzero(w, axis=1) <= 3).all()
+    assert (np.count_nonzero(feature_point_weights(_setup("feature_point")), axis=1) > 3).any()
+    with pytest.raises(FaceModelError, match="influences must be"):
+        feature_point_weights(_setup("feature_point", influences="all"))
+
+
 def test_l3_kshirsagar_weight() -> None:
     reach = np.array([2.0, 2.0, 2.0, 2.0])
     w = kshirsagar_weight(np.array([0.0, 1.0, 2.0, 3.0]), reach)
@@ -169,7 +179,7 @@ def test_t8_rbf_defaults_reproduce_the_thesis_multiquadric() -> None:
     assert np.array_equal(today, new)
 
 
-@pytest.mark.parametrize("kernel", ["multiquadric_eck", "thin_plate_spline", "gaussian",
+@pytest.mark.parametrize("kernel", ["multiquadric_eck", "wendland", "thin_plate_spline", "gaussian",
                                     "cubic", "inverse_multiquadric"])
 def test_t8_rbf_polynomial_reproduces_translation_and_affine_maps(kernel: str) -> None:
     rng = np.random.default_rng(5)

@@ -78,3 +78,30 @@ def test_custom_deformer_object(face: Face) -> None:
     np.testing.assert_allclose(moved[members], np.broadcast_to(moved[fp], (members.size, 3)),
                                atol=1e-7)
     assert np.abs(moved[fp]).max() > 0
+
+
+def test_definition_params_and_group_keys(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import json
+    import shutil
+    from importlib import resources
+    from pathlib import Path
+
+    head = Path(str(resources.files("facelib.data").joinpath("head")))
+    shutil.copy(head / "default_head.npz", tmp_path / "default_head.npz")
+    doc = json.loads((head / "default_head.json").read_text())
+    lip = next(r for r in doc["regions"] if r["name"] == "upper_lip")
+    lip["deformer"] = "soffd"
+    lip["params"] = {"local": 3.0}
+    path = tmp_path / "face.json"
+    path.write_text(json.dumps(doc))
+    face = load_face(path)
+    region = next(r for r in face.regions if r.name == "upper_lip")
+    assert region.deformer == "soffd" and dict(region.params) == {"local": 3.0}
+    lip["params"] = [1]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(FaceModelError, match="params must be an object"):
+        load_face(path)
+    lip["params"] = {"mode": "sometimes"}
+    path.write_text(json.dumps(doc))
+    with pytest.raises(FaceModelError, match="mode must be"):
+        load_face(path)

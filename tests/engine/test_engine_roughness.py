@@ -96,3 +96,14 @@ def test_flipped_triangles_counts_turned_over_ones() -> None:
     folded[3] = [-0.5, -0.5, 0.0]  # vertex 3 pulled across the shared edge
     assert flipped_triangles(verts, folded, tris) == 1
     assert flipped_triangles(verts, verts * [1, -1, 1], tris) == 2
+
+
+def test_r3_zero_area_triangle_counts_as_a_right_angle() -> None:
+    """A degenerate triangle has a zero normal, so each interior edge it shares scores
+    rho_d = 1 (documented in facelib.engine.quality)."""
+    from facelib.engine.quality import vertex_roughness
+
+    verts = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0]])
+    tris = np.array([[0, 1, 2], [0, 3, 1]])  # the second is flat on the x axis: zero area
+    g, _ = vertex_roughness(verts, tris)
+    assert g[0] == pytest.approx(1.0) and g[1] == pytest.approx(1.0)
