@@ -13,7 +13,8 @@ import numpy as np
 
 from facelib import expressions, gaze, visemes
 from facelib.checks import check_seed
-from facelib.cues import Storyboard
+from facelib.cues import MAX_FRAMES, Storyboard
+from facelib.errors import ParameterError
 from facelib.fdl import load
 from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
@@ -52,22 +53,31 @@ class Animation:
 
 
 def animate(
-    storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None
+    storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
+    max_frames: int = MAX_FRAMES,
 ) -> Animation:
     """Run the generators of a storyboard and resolve their conflicts.
 
     seed: overrides ``storyboard.seed``; the same storyboard and seed give the same stream
     bit for bit. rules: the synchronizer's weights (default ``facelib/data/sync.json``).
     The stream lasts as long as the longest track: the speech, or the last cue including a
-    frame at its very end.
+    frame at its very end. ``max_frames`` bounds its length (default
+    :data:`facelib.cues.MAX_FRAMES`); a longer storyboard raises ParameterError before
+    anything is computed.
     """
     if seed is not None:
         storyboard = replace(storyboard, seed=check_seed(seed))
     rules = rules or SyncRules.load()
     fps = storyboard.fps
-    speech = visemes.animate(storyboard.speech, fps=fps) if storyboard.speech else None
     # one frame past the last cue's end, so the face is shown settling back to neutral
     n_frames = math.floor(storyboard.cues_end_ms * fps / 1000 + 1e-9) + 1
+    if n_frames > max_frames:
+        raise ParameterError(
+            f"storyboard {storyboard.path or '(in memory)'} lasts {storyboard.cues_end_ms} ms "
+            f"= {n_frames} frames at {fps:g} fps, more than max_frames={max_frames}"
+        )
+    speech = (visemes.animate(storyboard.speech, fps=fps, max_frames=max_frames)
+              if storyboard.speech else None)
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
     speaking = np.zeros(n_frames, bool)

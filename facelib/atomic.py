@@ -1,55 +1,132 @@
 """Atomic file output: readers never see a half-written file, and a failure leaves any
-previous file as it was."""
+previous file as it was.
+
+The temporary file is written beside the target as ``.<stem>.<pid>.<random><suffix>``; a
+temporary file left by a process that no longer runs (killed with SIGKILL, say) is removed
+by the next write to the same folder. Only regular files are ever replaced: a device, pipe,
+folder or symbolic link at the target is refused, so ``-o /dev/null`` can never turn a
+device into a file.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from facelib.errors import FileError
+from facelib.errors import FileError, ParameterError
 
-__all__ = ["atomic_path", "write_text_atomic"]
+__all__ = ["atomic_path", "check_output_path", "publish", "temp_beside", "write_text_atomic"]
+
+_TEMP = re.compile(r"^\..+\.(?P<pid>[0-9]+)\.[A-Za-z0-9_]{8}(\.[^.]*)?$")
+
+
+def check_output_path(path: str | os.PathLike[str]) -> Path:
+    """``path`` as a Path, if a file may be written there; ParameterError naming it if it is
+    empty, an existing folder, device, pipe or symbolic link, or in a parent that is a file."""
+    text = os.fspath(path)
+    if not str(text).strip():
+        raise ParameterError("the output path is empty")
+    target = Path(text)
+    try:
+        info = target.lstat()
+    except FileNotFoundError:
+        info = None
+    except OSError as exc:
+        raise FileError.wrap(exc, "write", target) from exc
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(info.st_mode) else "a symbolic link"
+                if stat.S_ISLNK(info.st_mode) else "a device or pipe")
+        raise ParameterError(f"will not replace {str(target)!r}: it is {kind}, not a file")
+    return target
+
+
+def _sweep(folder: Path) -> None:
+    """Remove temporary files of earlier writes whose process has ended."""
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(folder):
+            match = _TEMP.match(entry.name)
+            if match and entry.is_file(follow_symlinks=False) and not _alive(int(match["pid"])):
+                with contextlib.suppress(OSError):
+                    Path(entry.path).unlink()
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def temp_beside(path: str | os.PathLike[str], *, suffix: str | None = None) -> Path:
+    """A new empty temporary file beside ``path`` (its folder created), named so that a later
+    write can sweep it if this process dies; ``suffix`` defaults to ``path``'s.
+
+    Raises ParameterError if ``path`` is not a place a file may be written
+    (:func:`check_output_path`), FileError naming it if the folder cannot be written.
+    """
+    path = check_output_path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _sweep(path.parent)
+        handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.{os.getpid()}.",
+                                        suffix=path.suffix if suffix is None else suffix)
+    except OSError as exc:
+        raise FileError.wrap(exc, "write", path) from exc
+    os.close(handle)
+    return Path(name)
+
+
+def publish(temp: Path, path: str | os.PathLike[str]) -> Path:
+    """Give ``temp`` the permissions of a normally created file and rename it onto ``path``."""
+    umask = os.umask(0)
+    os.umask(umask)
+    temp.chmod(0o666 & ~umask)  # mkstemp makes 0600
+    target = check_output_path(path)
+    temp.replace(target)
+    return target
 
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same suffix); on success rename it onto
-    ``path``, on any error remove it. Missing folders are made; the file gets the usual
-    permissions (0666 less the umask). An ``OSError`` (no permission, disk full, ...) is
-    raised as :class:`~facelib.errors.FileError` naming ``path``.
+    ``path``, on any error (KeyboardInterrupt included) remove it.
+
+    Raises ParameterError if ``path`` is not a place a file may be written
+    (:func:`check_output_path`), FileError (an ``OSError``) naming ``path`` if its folder
+    cannot be created or the rename fails.
 
     >>> with atomic_path("out.mp4") as temp:   # doctest: +SKIP
     ...     encode_video(temp)
     """
-    path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.",
-                                        suffix=path.suffix)
-    except OSError as exc:
-        raise FileError.wrap(exc, "write", path) from exc
-    os.close(handle)
-    temp = Path(name)
-    umask = os.umask(0)
-    os.umask(umask)
-    temp.chmod(0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
+    temp = temp_beside(path)
     try:
         yield temp
-        temp.replace(path)
-    except OSError as exc:
-        temp.unlink(missing_ok=True)
-        if isinstance(exc, FileError):
-            raise
-        raise FileError.wrap(exc, "write", path) from exc
+        try:
+            publish(temp, path)
+        except OSError as exc:
+            if isinstance(exc, FileError):
+                raise
+            raise FileError.wrap(exc, "write", path) from exc
     except BaseException:
         temp.unlink(missing_ok=True)
         raise
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically."""
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically; FileError naming
+    the path when it cannot be written (full disk, read-only folder, ...)."""
     with atomic_path(path) as temp:
-        temp.write_text(text, encoding="utf-8", newline="\n")
+        try:
+            temp.write_text(text, encoding="utf-8", newline="\n")
+        except OSError as exc:
+            raise FileError.wrap(exc, "write", path) from exc

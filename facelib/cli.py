@@ -8,7 +8,7 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import facelib
 from facelib.errors import FacelibError
@@ -119,6 +119,102 @@ def _align(args: argparse.Namespace) -> int:
     return 0
 
 
+def _evaluate(args: argparse.Namespace) -> int:
+    from facelib.evaluate import DEFORMERS, evaluate_deformers, evaluation_poses, write_evaluation
+
+    names = tuple(n.strip() for n in args.deformers.split(",")) if args.deformers else DEFORMERS
+    kinds = tuple(k.strip() for k in args.poses.split(","))
+    ev = evaluate_deformers(names, group=args.region, poses=evaluation_poses(kinds),
+                            face_path=args.face)
+    for path in write_evaluation(ev, args.output, sheet=not args.no_sheet, stem=args.stem,
+                                 face_path=args.face):
+        print(f"wrote {path}")
+    return 0
+
+
+def _span(text: str) -> tuple[int, int]:
+    """``"N"`` -> (N, N + 1); ``"A:B"`` -> (A, B)."""
+    try:
+        first, _, last = text.partition(":")
+        return (int(first), int(last)) if last else (int(first), int(first) + 1)
+    except ValueError:
+        raise FacelibError(f"frames must be N or START:STOP, got {text!r}") from None
+
+
+def _track(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from facelib.tracking.faps import measure_faps
+
+    source = Path(args.source)
+    states = None
+    options: dict[str, Any] = {"neutral": _span(args.neutral), "smooth": not args.no_smooth}
+    if source.is_dir() or source.suffix.lower() in (".csv", ".json", ".pts"):
+        from facelib.tracking.files import read_landmarks
+
+        file = read_landmarks(source)
+        fps = args.fps or file.fps
+        layout = args.layout or file.layout
+        if fps is None or layout is None:
+            raise FacelibError(f"{source}: give --fps and --layout (the file does not say)")
+        landmarks, video = file.landmarks, None
+    else:
+        from facelib.tracking.video import track_video
+
+        track = track_video(source, max_frames=args.max_frames)
+        landmarks, fps, layout, video = track.landmarks, track.info.fps, "mediapipe", source
+        print(f"tracked {len(landmarks)} frames of {source} ({track.info.width}x"
+              f"{track.info.height}, {fps:g} fps); no face in {len(track.lost_frames)}")
+    if args.pucker:
+        mask = np.zeros(len(landmarks), bool)
+        for text in args.pucker:
+            start, stop = _span(text)
+            mask[start:stop] = True
+        states = {"pucker": mask}
+    result = measure_faps(landmarks, fps=fps, layout=layout, states=states, **options)
+    print("user FAPU (pixels): " + ", ".join(f"{k}0={v * 1024:.1f}"
+                                             for k, v in result.fapu.items() if k != "AU"))
+    _write_fap(result.stream, args.output, args.dialect)
+    if args.landmarks_out:
+        from facelib.tracking.files import write_landmarks_csv
+
+        print(f"wrote {write_landmarks_csv(args.landmarks_out, landmarks, fps=fps)}")
+    if args.render:
+        if video is None:
+            raise FacelibError("--render needs a video source (the mirror shows it)")
+        from facelib.engine import load_face
+        from facelib.tracking.mirror import render_mirror
+
+        out = render_mirror(video, result.stream, args.render, face=load_face(args.face),
+                            landmarks=landmarks if args.show_landmarks else None)
+        print(f"wrote {out}")
+    return 0
+
+
+def _add_track_command(commands: Any) -> None:
+    track = commands.add_parser(
+        "track", help="performance-driven animation: a face video (or landmarks) to FAPs")
+    track.add_argument("source", help="a video, or landmarks: .csv (facelib/generic, "
+                       "OpenFace), .json, .pts or a folder of .pts")
+    track.add_argument("-o", "--output", required=True, help="the .fap file to write")
+    track.add_argument("--landmarks-out", help="also write the landmarks as CSV")
+    track.add_argument("--render", help="also write the Virtual Mirror video (source | avatar)")
+    track.add_argument("--face", help="the avatar's face definition (default: bundled head)")
+    track.add_argument("--show-landmarks", action="store_true",
+                       help="draw the tracked landmarks on the mirror's source side")
+    track.add_argument("--neutral", default="0", help="neutral frame N or span START:STOP")
+    track.add_argument("--pucker", action="append", metavar="START:STOP",
+                       help="frames labelled pucker (eq. 4.17 high-level state); repeatable")
+    track.add_argument("--no-smooth", action="store_true", help="skip the One Euro filter")
+    track.add_argument("--layout", choices=("mediapipe", "ibug68"),
+                       help="landmark files: the point layout (default: by point count)")
+    track.add_argument("--fps", type=float, help="landmark files: their frame rate")
+    track.add_argument("--max-frames", type=int, help="videos: track at most this many frames")
+    track.add_argument("--dialect", default="extended",
+                       choices=("standard", "xface", "greta", "extended"))
+    track.set_defaults(run=_track)
+
+
 def _add_render_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("-o", "--output", required=True,
                          help="OUT.mp4, OUT.gif, or a folder for PNG frames")
@@ -178,6 +274,13 @@ def _build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--seed", type=int)
     plot.set_defaults(run=_plot)
 
+    _add_tool_commands(commands)
+    _add_track_command(commands)
+    return parser
+
+
+def _add_tool_commands(commands: Any) -> None:
+    """The ``align`` and ``evaluate`` commands."""
     align = commands.add_parser("align", help="align speech audio to visemes")
     align.add_argument("audio", help="speech audio (any format soundfile reads)")
     align.add_argument("--text", help="the transcript (omit for phone-loop recognition)")
@@ -185,7 +288,18 @@ def _build_parser() -> argparse.ArgumentParser:
     align.add_argument("-o", "--output", required=True, help="OUT.json, OUT.tsv or OUT.sb")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.set_defaults(run=_align)
-    return parser
+
+    evaluate = commands.add_parser(
+        "evaluate", help="compare deformers by lip roughness (CSV, Markdown, contact sheet)")
+    evaluate.add_argument("-o", "--output", required=True, help="folder for the results")
+    evaluate.add_argument("--deformers", help="comma-separated names (default: all seven)")
+    evaluate.add_argument("--region", default="lips", help="region or group to switch")
+    evaluate.add_argument("--poses", default="viseme,expression,syllable",
+                          help="comma-separated pose kinds: viseme, expression, syllable")
+    evaluate.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    evaluate.add_argument("--stem", default="deformers", help="file name stem")
+    evaluate.add_argument("--no-sheet", action="store_true", help="skip the mouth contact sheet")
+    evaluate.set_defaults(run=_evaluate)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

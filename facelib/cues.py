@@ -13,7 +13,16 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-__all__ = ["ExpressionCue", "GazeCue", "Origin", "SpeechSpec", "Storyboard", "VisemeCue"]
+__all__ = [
+    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "ExpressionCue", "GazeCue", "Origin", "SpeechSpec",
+    "Storyboard", "VisemeCue",
+]
+
+MAX_FRAMES = 360_000
+"""Most frames an animation may have unless the caller raises it (``animate(max_frames=)``):
+four hours at 25 fps. Checked before any per-frame array is allocated."""
+MAX_SPEECH_TEXT_CHARS = 100_000
+"""Longest text of one speech cue (about two hours of speech)."""
 
 Origin = tuple[str, int]
 """(file, 1-based line) of the script text a cue came from."""

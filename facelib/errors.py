@@ -7,6 +7,7 @@ the file and line it came from.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 __all__ = [
@@ -23,6 +24,8 @@ __all__ = [
     "RenderError",
     "SpeechError",
     "SpeechWarning",
+    "TrackingError",
+    "TrackingWarning",
 ]
 
 
@@ -85,11 +88,16 @@ class FileError(FacelibError, OSError):
     (``OSError``, kept as ``__cause__``) with the path it concerns."""
 
     @classmethod
-    def wrap(cls, exc: OSError, what: str, path: str | Path) -> FileError:
+    def wrap(cls, exc: OSError, what: str, path: str | os.PathLike[str]) -> FileError:
         """``FileError`` for ``exc`` raised while doing ``what`` ("write", "read") at
         ``path``."""
         reason = exc.strerror or str(exc)
-        return cls(f"cannot {what}: {reason}", path=path)
+        return cls(f"cannot {what}: {reason}", path=os.fspath(path))
+
+
+class TrackingError(FacelibError):
+    """A video or landmark track cannot be turned into FAPs (no face, unreadable video,
+    wrong point count, missing feature points); the message names the frames."""
 
 
 class MissingExtraError(FacelibError, ImportError):
@@ -113,3 +121,7 @@ class FdlWarning(FacelibWarning):
 
 class SpeechWarning(FacelibWarning):
     """An alignment succeeded but looks implausible (named word, reason)."""
+
+
+class TrackingWarning(FacelibWarning):
+    """Tracking went on but lost the face in some frames, or saw several faces (names them)."""

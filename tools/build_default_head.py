@@ -671,6 +671,7 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
         regions.append(
             {
                 "name": name,
+                "group": "lips",
                 "deformer": "rbf",
                 "feature_points": fps,
                 "vertices": members.tolist(),
@@ -694,6 +695,7 @@ def make_regions(pos, skin, fp, *, ranges, lower_frac, skin_target, mouth_y, x_c
         regions.append(
             {
                 "name": f"brow_{side}",
+                "group": "brows",
                 "deformer": "rbf",
                 "feature_points": ids,
                 "vertices": inner.tolist(),

@@ -8,14 +8,17 @@ or float 0-1).
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
 from facelib import data
-from facelib.engine.face import DEFORMERS, PART_NAMES, Face, Region
-from facelib.errors import FaceModelError
+from facelib.engine.face import PART_NAMES, RIGID_DEFORMERS, Face, Region
+from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
+from facelib.errors import FaceModelError, ParameterError
 from facelib.mpeg4.tables import fap_table, feature_point_table
 
 __all__ = ["FORMAT", "VERSION", "load_face", "required_feature_points"]
@@ -44,17 +47,28 @@ def default_face() -> Face:
     return load_face(None)
 
 
-def load_face(path: str | Path | None = None) -> Face:
+Override = str | Deformer | Mapping[str, Any]
+"""A deformer override: a registered name, a Deformer, or ``{"deformer": name, **params}``."""
+
+
+def load_face(
+    path: str | Path | None = None, *, deformers: Mapping[str, Override] | None = None
+) -> Face:
     """Load a face definition and its mesh, validate them and compile the deformers.
 
     Parameters
     ----------
     path: the JSON face definition; None loads facelib's default head (metres).
+    deformers: overrides of the definition's deformers, keyed by region name or group
+        (``{"lips": "inverse_distance", "brow_l": {"deformer": "rbf", "kernel": "gaussian"}}``);
+        a region name wins over its group. A bare name keeps no parameters of the
+        definition; give them in the mapping form. Every key must match a region.
 
     Raises
     ------
     FaceModelError: unreadable or malformed file, missing feature points, out-of-range
         indices, empty regions, unknown deformers or pivots; the message names the item.
+    ParameterError: an override key that names no region or group.
     """
     path = _default_path() if path is None else Path(path)
     try:
@@ -65,13 +79,28 @@ def load_face(path: str | Path | None = None) -> Face:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise FaceModelError(f"invalid JSON: {exc.msg}", path=path, line=exc.lineno) from exc
-    return _Reader(path, doc).face()
+    return _Reader(path, doc, dict(deformers or {})).face()
+
+
+def _override(value: Override, key: str) -> tuple[str, Deformer | None, dict[str, Any]]:
+    """(name, custom deformer or None, params) of one override value."""
+    if isinstance(value, Deformer):
+        return value.name, value, {}
+    if isinstance(value, str):
+        return value, None, {}
+    if isinstance(value, Mapping) and isinstance(value.get("deformer"), (str, Deformer)):
+        params = {k: v for k, v in value.items() if k != "deformer"}
+        name, custom, _ = _override(value["deformer"], key)
+        return name, custom, params
+    raise ParameterError(f"deformers[{key!r}] must be a deformer name, a Deformer or a "
+                         f"mapping with a 'deformer' key, not {value!r}")
 
 
 class _Reader:
-    def __init__(self, path: Path, doc: Any):
+    def __init__(self, path: Path, doc: Any, overrides: dict[str, Override]):
         self.path = path
         self.doc = doc
+        self.overrides = overrides
 
     def fail(self, message: str) -> FaceModelError:
         return FaceModelError(message, path=self.path)
@@ -206,6 +235,11 @@ class _Reader:
                 raise self.fail(f"region {item['name']!r} is defined twice")
             names.add(item["name"])
             out.append(self.region(item, nv, points, pivots))
+        unused = sorted(set(self.overrides) - names - {r.group for r in out})
+        if unused:
+            known = sorted(names | {r.group for r in out if r.group})
+            raise ParameterError(f"deformers override {unused[0]!r} names no region or group "
+                                 f"of {self.path.name} (known: {', '.join(known)})")
         return tuple(out)
 
     def region(
@@ -213,10 +247,12 @@ class _Reader:
         pivots: dict[str, np.ndarray],
     ) -> Region:
         """One entry of ``regions`` (an object with a string ``name``)."""
-        where = f"region {item['name']!r}"
-        deformer = item.get("deformer")
-        if deformer not in DEFORMERS:
-            raise self.fail(f"{where} has deformer {deformer!r}; known: {DEFORMERS}")
+        name = item["name"]
+        where = f"region {name!r}"
+        group = item.get("group", "")
+        if not isinstance(group, str):
+            raise self.fail(f"{where} group must be a string, not {group!r}")
+        deformer_name, custom, params = self.deformer_of(item, name, group, where)
         controls = item.get("feature_points")
         if not isinstance(controls, list) or not controls:
             raise self.fail(f"{where} needs a non-empty list of feature_points")
@@ -225,12 +261,25 @@ class _Reader:
                 raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
         vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
         anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors", allow_empty=True)
-        weights = np.zeros(0, np.float32)
-        pivot = ""
+        deformer = ALIASES.get(deformer_name, deformer_name)
         if deformer == "rbf" and len(controls) + anchors.size < 2:
             raise self.fail(f"{where}: an RBF needs at least two sources")
+        weights, pivot = self.rigid_fields(item, deformer, where, n_controls=len(controls),
+                                           vertices=vertices, pivots=pivots)
+        return Region(name=name, deformer=deformer, feature_points=tuple(controls),
+                      vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
+                      pivot=pivot, params=MappingProxyType(params), group=group, custom=custom)
+
+    def rigid_fields(
+        self, item: dict[str, Any], deformer: str, where: str, *, n_controls: int,
+        vertices: np.ndarray, pivots: dict[str, np.ndarray],
+    ) -> tuple[np.ndarray, str]:
+        """``weights`` ((Vr,), for weights and eyelid regions, else empty) and ``pivot`` (for
+        eyelid regions, else "") of a region entry."""
+        weights = np.zeros(0, np.float32)
+        pivot = ""
         if deformer in ("weights", "eyelid"):
-            if len(controls) != 1:
+            if n_controls != 1:
                 raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
             weights = np.asarray(item.get("weights", []), dtype=np.float64)
             if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
@@ -239,6 +288,25 @@ class _Reader:
             pivot = str(item.get("pivot"))
             if pivot not in pivots:
                 raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
-        return Region(name=item["name"], deformer=deformer, feature_points=tuple(controls),
-                      vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
-                      pivot=pivot)
+        return weights, pivot
+
+    def deformer_of(self, item: dict, name: str, group: str, where: str
+                    ) -> tuple[str, Deformer | None, dict[str, Any]]:
+        """The region's deformer name, custom deformer and parameters, overrides applied."""
+        key = name if name in self.overrides else group if group in self.overrides else None
+        if key is not None and item.get("deformer") not in RIGID_DEFORMERS:
+            return _override(self.overrides[key], key)
+        if key is not None:
+            raise ParameterError(f"deformers[{key!r}]: {where} is an eyelid (a rigid step); "
+                                 "it cannot take another deformer")
+        name_ = item.get("deformer")
+        if name_ not in RIGID_DEFORMERS:
+            try:
+                deformer(name_ if isinstance(name_, str) else repr(name_))
+            except FaceModelError:
+                raise self.fail(f"{where} has deformer {name_!r}; known: "
+                                f"{(*deformer_names(), *RIGID_DEFORMERS)}") from None
+        params = item.get("params", {})
+        if not isinstance(params, dict):
+            raise self.fail(f"{where} params must be an object, not {params!r}")
+        return str(name_), None, dict(params)

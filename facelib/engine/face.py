@@ -22,13 +22,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from facelib.engine import rigid
-from facelib.engine.deformers import explicit_weights, raised_cosine_weights, rbf_weights
 from facelib.engine.fapu import compute_fapu
+from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
 from facelib.errors import FaceModelError, ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
@@ -36,8 +37,8 @@ from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 __all__ = ["PART_NAMES", "Face", "Part", "Region"]
 
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
-LINEAR_DEFORMERS = ("cosine", "rbf", "weights")
-DEFORMERS = (*LINEAR_DEFORMERS, "eyelid")
+RIGID_DEFORMERS = ("eyelid",)
+"""Deformers that are per-frame rigid steps of the face, not entries of the registry."""
 # The rigid steps address FAPs by their names in the standard's table (facelib.mpeg4).
 # Eyelid feature point -> the FAP that closes that lid (step 2).
 _EYELID_FAPS = {"3.1": "close_t_l_eyelid", "3.2": "close_t_r_eyelid",
@@ -81,13 +82,16 @@ class Region:
     """An influence region of the face definition.
 
     name: unique name.
-    deformer: ``"cosine"`` (eq. 4.7), ``"rbf"`` (eq. 4.8-4.10), ``"weights"`` (explicit
-        per-vertex weights of one feature point) or ``"eyelid"`` (rotation over the eye).
+    deformer: a name of :mod:`facelib.engine.registry` (``raised_cosine``, ``rbf``,
+        ``weights``, ...) or ``"eyelid"`` (rotation over the eye).
     feature_points: ids of the controlling feature points.
     vertices: (Vr,) int32 member vertices (the ones that move).
     anchors: (A,) int32 static border vertices (RBF only; empty otherwise).
     weights: (Vr,) float32 (``weights`` and ``eyelid`` only; empty otherwise).
     pivot: pivot name (``eyelid`` only).
+    params: the deformer's parameters as the definition (or an override) gives them.
+    group: an optional group name (``"lips"``) that overrides may use instead of the name.
+    custom: a :class:`~facelib.engine.registry.Deformer` given directly instead of a name.
     """
 
     name: str
@@ -97,6 +101,14 @@ class Region:
     anchors: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
     weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
     pivot: str = ""
+    params: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    group: str = ""
+    custom: Deformer | None = None
+
+    @property
+    def algorithm(self) -> Deformer:
+        """The registered (or custom) deformer of this region; not for ``eyelid``."""
+        return self.custom if self.custom is not None else deformer(self.deformer)
 
 
 def _columns(ids: np.ndarray, axes: str = "xyz") -> np.ndarray:
@@ -182,6 +194,7 @@ class Face:
     _columns: np.ndarray = field(repr=False)
     _dense: np.ndarray = field(repr=False)
     _rigid: _Rigid = field(repr=False)
+    _steps: tuple[_Step, ...] = field(repr=False, default=())
 
     @classmethod
     def build(
@@ -207,7 +220,7 @@ class Face:
         fapu = MappingProxyType(compute_fapu(verts, points))
         part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
-        operator = _compile(verts, tris, points, fapu, regions)
+        operator, steps = _compile(verts, tris, points, fapu, regions)
         _check_eyes_rigid(regions, part_map)
         columns = np.unique(operator.indices).astype(np.int64)
         return cls(
@@ -224,6 +237,7 @@ class Face:
             _dense=operator[:, columns].toarray().astype(np.float32),
             _rigid=_rigid(verts, points=points, fapu=fapu, regions=regions, parts=part_map,
                           pivots=pivot_map, neck=neck),
+            _steps=steps,
         )
 
     @property
@@ -259,6 +273,8 @@ class Face:
             if active.size:
                 flat[:, self._columns] += fb[:, active] @ self._dense[active]
             f64 = fb.astype(np.float64)
+            for step in self._steps:
+                step.apply(flat, f64)
             self._move_lids(pos, f64)
             self._move_eyes(pos, f64)
             self._move_jaw(pos, f64)
@@ -322,72 +338,103 @@ class Face:
             neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
 
 
-def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.ndarray:
-    """Ids of the members that share a triangle with a vertex outside ``members``."""
-    inside = np.zeros(n_vertices, bool)
-    inside[members] = True
-    mixed = triangles[inside[triangles].any(1) & ~inside[triangles].all(1)]
-    return np.unique(mixed[inside[mixed]])
-
-
-def _compile(
-    verts: np.ndarray, triangles: np.ndarray, points: Mapping[str, int],
-    fapu: Mapping[str, float], regions: tuple[Region, ...],
-) -> sp.csr_array:
-    """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP."""
-    nv = len(verts)
-    carried = _carried(verts, triangles, points, regions)
-    rows, cols, vals = [], [], []
+def _fp_motion(fapu: Mapping[str, float]) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """Per feature point: (FAP column, displacement per FAP unit (3,)) of every translational
+    FAP that moves it through the operator (eq. 4.6)."""
+    out: dict[str, list[tuple[int, np.ndarray]]] = {}
     for f in fap_table():
         if f.kind != "translation" or f.fapu not in fapu or f.name in _EYELID_FAPS.values():
             continue
         if f.name in _EYE_THRUSTS:  # eyeball thrust moves the whole eye (rigid step)
             continue
-        fp_id = f.feature_points[0]
         scale = fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
-        for members, w in carried.get(fp_id, ()):
-            for axis in range(3):
-                if scale[axis] == 0:
-                    continue
-                rows.append(np.full(members.size, f.index))
-                cols.append(members * 3 + axis)
-                vals.append(w * scale[axis])
+        out.setdefault(f.feature_points[0], []).append((f.index, scale))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class _Step:
+    """A non-linear region, corrected per frame: members += exact(dC) - linear(dC).
+
+    columns: (3Vr,) int64 columns of the members; motion: (84, 3N) float64 control
+    displacement per FAP unit; linear: (3N, 3Vr) float64 the region's operator block.
+    """
+
+    columns: np.ndarray
+    motion: np.ndarray
+    linear: np.ndarray
+    step: FrameStep
+
+    def apply(self, flat: np.ndarray, f: np.ndarray) -> None:
+        dc = f @ self.motion
+        if not dc.any():
+            return
+        n = len(f)
+        exact = self.step.displace(dc.reshape(n, -1, 3)).reshape(n, -1)
+        flat[:, self.columns] += (exact - dc @ self.linear).astype(np.float32)
+
+
+def _region_weights(
+    region: Region, pos: np.ndarray, triangles: np.ndarray, points: Mapping[str, int]
+) -> tuple[np.ndarray, FrameStep | None]:
+    """``(Vr, 3, N, 3)`` weights of one region and its exact step (None when linear)."""
+    algo = region.algorithm
+    setup = RegionSetup(
+        name=region.name, members=region.vertices.astype(np.int64),
+        controls=np.array([points[p] for p in region.feature_points], np.int64),
+        anchors=region.anchors.astype(np.int64), vertices=pos, triangles=triangles,
+        weights=region.weights.astype(np.float64),
+        params=MappingProxyType(algo.resolve(region.params, region=region.name)))
+    w = np.asarray(algo.weights(setup), dtype=np.float64)
+    vr, n = setup.members.size, setup.controls.size
+    if w.shape == (vr, n):
+        w = w[:, None, :, None] * np.eye(3)[None, :, None, :]
+    elif w.shape != (vr, 3, n, 3):
+        raise FaceModelError(f"region {region.name!r}: deformer {algo.name!r} returned "
+                             f"weights of shape {w.shape}, not ({vr}, {n}) or ({vr}, 3, {n}, 3)")
+    exact = setup.params.get("mode") == "exact" and algo.step is not None
+    return w, (algo.step(setup) if exact and algo.step is not None else None)
+
+
+def _compile(
+    verts: np.ndarray, triangles: np.ndarray, points: Mapping[str, int],
+    fapu: Mapping[str, float], regions: tuple[Region, ...],
+) -> tuple[sp.csr_array, tuple[_Step, ...]]:
+    """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP,
+    and the per-frame steps of non-linear regions."""
+    nv = len(verts)
+    pos = verts.astype(np.float64)
+    tris = triangles.astype(np.int64)
+    motion = _fp_motion(fapu)
+    rows, cols, vals = [], [], []
+    steps = []
+    for region in regions:
+        if region.deformer in RIGID_DEFORMERS:
+            continue
+        w, step = _region_weights(region, pos, tris, points)
+        members = region.vertices.astype(np.int64)
+        # g: (84, N, 3) control displacement per FAP unit
+        g = np.zeros((N_FAPS, len(region.feature_points), 3))
+        for k, fp_id in enumerate(region.feature_points):
+            for index, scale in motion.get(fp_id, ()):
+                g[index, k] += scale
+        block = np.einsum("vaib,fib->fva", w, g)  # (84, Vr, 3)
+        fi, vi, ai = np.nonzero(block)
+        rows.append(fi)
+        cols.append(members[vi] * 3 + ai)
+        vals.append(block[fi, vi, ai])
+        if step is not None:
+            steps.append(_Step(_columns(members), g.reshape(N_FAPS, -1),
+                               w.reshape(members.size * 3, -1).T.copy(), step))
     if not rows:
-        return sp.csr_array((N_FAPS, nv * 3), dtype=np.float32)
+        return sp.csr_array((N_FAPS, nv * 3), dtype=np.float32), ()
     coo = sp.coo_array(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
         shape=(N_FAPS, nv * 3),
     )
     out = coo.tocsr().astype(np.float32)
     out.sum_duplicates()
-    return out
-
-
-def _carried(
-    verts: np.ndarray, triangles: np.ndarray, points: Mapping[str, int],
-    regions: tuple[Region, ...],
-) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
-    """Per feature point: (member ids (K,) int64, weights (K,) float64) of every linear
-    region it controls, zero weights dropped."""
-    nv = len(verts)
-    pos = verts.astype(np.float64)
-    carried: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
-    for region in regions:
-        if region.deformer not in LINEAR_DEFORMERS:
-            continue
-        members = region.vertices.astype(np.int64)
-        controls = pos[[points[p] for p in region.feature_points]]
-        if region.deformer == "cosine":
-            edge = pos[_edge(members, triangles, nv)]
-            w = raised_cosine_weights(pos[members], controls, edge=edge)
-        elif region.deformer == "rbf":
-            w = rbf_weights(pos[members], controls, pos[region.anchors])
-        else:
-            w = explicit_weights(region.weights)
-        for k, fp_id in enumerate(region.feature_points):
-            keep = w[:, k] != 0
-            carried.setdefault(fp_id, []).append((members[keep], w[keep, k]))
-    return carried
+    return out, tuple(steps)
 
 
 def _lids(

@@ -35,6 +35,7 @@ __all__ = ["load", "loads"]
 log = logging.getLogger("facelib.fdl")
 
 DEFAULT_FPS = 25.0
+_MIN_FPS = 1.0
 _MAX_FPS = 1000.0
 
 
@@ -159,10 +160,10 @@ def _fps(chunk: ChunkResult, text: str, name: str) -> float:
     if (
         isinstance(fps, bool)
         or not isinstance(fps, int | float)
-        or not (math.isfinite(fps) and 0 < fps <= _MAX_FPS)
+        or not (math.isfinite(fps) and _MIN_FPS <= fps <= _MAX_FPS)
     ):
         raise FdlError(
-            f"fps must be a number above 0 and at most {_MAX_FPS:g}; got {fps!r}",
+            f"fps must be a number from {_MIN_FPS:g} to {_MAX_FPS:g}; got {fps!r}",
             path=name,
             line=_line(text, "fps"),
         )
@@ -190,19 +191,56 @@ def _build(
     # thesis lists run from 0; the modern syntax's cues without ``at`` follow on
     expressions = thesis_cues.expression_cues(lists.get("expressions"))
     gaze = thesis_cues.gaze_cues(lists.get("eyes"))
+    speech = _speech(fdl, fdl_line, lists.get("Sentence"), parts, ctx)
+    output = _output(chunk, fdl, fdl_line, ctx)
+    if output is not None:
+        _check_output(output, inputs=(file, *_inputs_of(speech)), path=name,
+                      line=_output_line(ctx, fdl, fdl_line))
     return Storyboard(
         path=file,
         fps=fps,
         seed=seed,
-        speech=_speech(fdl, fdl_line, lists.get("Sentence"), parts, ctx),
+        speech=speech,
         expressions=_by_start((*expressions, *modern_cues.expression_cues(
             parts.expressions, ctx, after_ms=_end(expressions)))),
         gaze=_by_start((*gaze, *modern_cues.gaze_cues(parts.gaze, ctx, after_ms=_end(gaze)))),
         expression_defs=parts.expression_defs,
         gaze_defs=parts.gaze_defs,
-        output=_output(chunk, fdl, fdl_line, ctx),
+        output=output,
         expression_mixes=parts.expression_mixes,
     )
+
+
+OUTPUT_SUFFIXES = (".fap", ".mp4", ".gif")
+"""What a storyboard's ``output`` may name: the files facelib writes."""
+
+
+def _inputs_of(speech: SpeechSpec | None) -> tuple[Path, ...]:
+    if speech is None or speech.audio is None:
+        return ()
+    return (Path(speech.audio),)
+
+
+def _check_output(output: Path, *, inputs: tuple[Path | None, ...], path: str,
+                  line: int | None) -> None:
+    """A storyboard may only name an output facelib writes: a known suffix, not a hidden
+    file, not the storyboard itself or a file it reads."""
+    if output.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise FdlError(f"output {output.name!r} must end in one of {', '.join(OUTPUT_SUFFIXES)}",
+                       path=path, line=line)
+    if output.name.startswith("."):
+        raise FdlError(f"output {output.name!r} must not be a hidden file", path=path, line=line)
+    if any(source is not None and output == source.resolve() for source in inputs):
+        raise FdlError(f"output {output.name!r} would overwrite one of the storyboard's inputs",
+                       path=path, line=line)
+
+
+def _output_line(ctx: Context, fdl: dict[str, str | None] | None, fdl_line: int | None
+                 ) -> int | None:
+    """The line that sets the output: ``FDL.output`` or the global."""
+    if fdl is not None and "output" in fdl:
+        return ctx.line_of("output", after=fdl_line)
+    return _line(ctx.source, "output")
 
 
 def _calls(chunk: ChunkResult) -> list[tuple[str, object, int | None, int]]:

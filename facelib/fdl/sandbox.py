@@ -12,8 +12,12 @@ An ``.fdl`` file is untrusted code. :class:`Sandbox` runs it in ``lupa.lua54`` w
   (kept in :attr:`Sandbox.printed`; the loader passes it to the ``facelib.fdl`` logger),
   plus the storyboard functions the caller names;
 - chunks compiled from text only (mode ``"t"``) under their file name;
-- a memory cap (``max_memory``) and an instruction budget enforced by a count hook that
-  the host installs before user code runs; user ``pcall`` cannot catch either limit;
+- a memory cap (``max_memory``), an instruction budget enforced by a count hook that the
+  host installs before user code runs, with the C work of the string and table libraries
+  charged to it (one instruction per byte or element), and a wall-clock limit
+  (``max_seconds``) checked by the same hook; user ``pcall`` cannot catch any limit;
+- ``pairs`` that visits keys in a stable order (numbers, strings, booleans sorted), so a
+  script gives the same storyboard whatever Lua's per-state string hash seed is;
 - the string metatable's ``__index`` pointing to the sandbox's own ``string`` copy.
 
 Every failure is raised as :class:`~facelib.errors.FdlError` with the file and line; the
@@ -23,6 +27,7 @@ sandbox stays usable afterwards.
 from __future__ import annotations
 
 import re
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,18 +39,24 @@ from facelib.fdl.marking import mark_tables
 __all__ = [
     "DEFAULT_MAX_INSTRUCTIONS",
     "DEFAULT_MAX_MEMORY",
+    "DEFAULT_MAX_SECONDS",
     "WHITELIST",
     "ChunkResult",
     "Sandbox",
+    "one_line",
 ]
 
 DEFAULT_MAX_MEMORY = 64 * 1024 * 1024
 """Bytes the whole Lua state may hold (64 MiB)."""
 DEFAULT_MAX_INSTRUCTIONS = 100_000_000
 """Lua VM instructions one chunk may execute (well under a second of pure Lua on a laptop core)."""
+DEFAULT_MAX_SECONDS = 5.0
+"""Wall-clock seconds one chunk may run."""
 MAX_SOURCE_BYTES = 1024 * 1024
 """Largest script text accepted (1 MiB)."""
 _MAX_PRINT_CHARS = 2000
+_MAX_PRINT_LINES = 1000
+_MAX_MESSAGE_CHARS = 300
 
 WHITELIST = (
     "string", "table", "math", "utf8", "pairs", "ipairs", "select", "type", "tostring",
@@ -81,7 +92,11 @@ class Sandbox:
     Parameters
     ----------
     max_memory: bytes the Lua state may allocate in all.
-    max_instructions: VM instructions one chunk may execute.
+    max_instructions: VM instructions one chunk may execute (C work of the string and table
+        libraries counts one per byte or element).
+    max_seconds: wall-clock seconds one chunk may run.
+
+    ``printed`` keeps the first 1000 lines a script prints (each cut to 2000 characters).
     """
 
     def __init__(
@@ -89,13 +104,17 @@ class Sandbox:
         *,
         max_memory: int = DEFAULT_MAX_MEMORY,
         max_instructions: int = DEFAULT_MAX_INSTRUCTIONS,
+        max_seconds: float = DEFAULT_MAX_SECONDS,
     ) -> None:
         if max_memory < 1024 * 1024:
             raise FdlError(f"max_memory={max_memory} is below the 1 MiB a Lua state needs")
         if max_instructions < 1000:
             raise FdlError(f"max_instructions={max_instructions} is below 1000")
+        if not (isinstance(max_seconds, int | float) and 0 < max_seconds <= 3600):
+            raise FdlError(f"max_seconds={max_seconds!r} must be in (0, 3600]")
         self.max_memory = int(max_memory)
         self.max_instructions = int(max_instructions)
+        self.max_seconds = float(max_seconds)
         self.printed: list[str] = []
         self._start()
 
@@ -113,10 +132,15 @@ class Sandbox:
         boot = data.text("fdl/sandbox.lua")
         # The bootstrap needs the standard library, so it runs without the memory cap.
         self._run, self._collect = self._lua.execute(
-            boot, self._print, name="=fdl-sandbox", mode="t"
+            boot, self._print, time.monotonic, name="=fdl-sandbox", mode="t"
         )
 
     def _print(self, text: object) -> None:
+        if len(self.printed) > _MAX_PRINT_LINES:
+            return
+        if len(self.printed) == _MAX_PRINT_LINES:
+            self.printed.append(f"... (printing stopped after {_MAX_PRINT_LINES} lines)")
+            return
         message = str(text)
         if len(message) > _MAX_PRINT_CHARS:
             message = message[:_MAX_PRINT_CHARS] + "..."
@@ -145,7 +169,8 @@ class Sandbox:
         api = self._lua.table_from(list(functions))
         lua_seed = int(seed) % (1 << 63)
         try:
-            result = self._run(source, marked, "@" + short, self.max_instructions, lua_seed, api)
+            result = self._run(source, marked, "@" + short, self.max_instructions, lua_seed, api,
+                               self.max_seconds)
         except self._lupa.LuaMemoryError:
             self._restart()
             raise FdlError(
@@ -167,6 +192,13 @@ class Sandbox:
     def collect(self) -> None:
         """Free what finished chunks left (called by the loader between chunks)."""
         self._collect()
+
+
+def one_line(text: str, *, limit: int = _MAX_MESSAGE_CHARS) -> str:
+    """``text`` made safe to print as part of one message line: control characters (line
+    breaks included) shown as escapes, and cut to ``limit`` characters."""
+    safe = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text[: limit + 1])
+    return safe if len(safe) <= limit else safe[:limit] + "..."
 
 
 def _chunk_short_name(path: str) -> str:
@@ -192,6 +224,12 @@ def _error(
             path=path,
             line=where,
         )
+    if kind == "time":
+        return FdlError(
+            f"script ran longer than the sandbox time limit ({limits.max_seconds:g} s)",
+            path=path,
+            line=where,
+        )
     if kind == "memory":
         return FdlError(
             f"script exceeded the sandbox memory limit ({limits.max_memory} bytes)",
@@ -204,6 +242,11 @@ def _error(
     ):
         where = int(m.group("line"))
         message = m.group("msg")
+    message = one_line(message)
+    if kind == "syntax" and "too many registers" in message:
+        return FdlError("tables or expressions nested too deeply for the sandbox (it marks "
+                        "every table with its line; about 80 levels fit)", path=path,
+                        line=where)
     if kind == "syntax":
         return FdlError(f"syntax error: {message}", path=path, line=where)
     g = _GLOBAL.search(message)

@@ -17,6 +17,8 @@ __all__ = ["LuaTable", "Opaque", "to_python"]
 
 _MAX_DEPTH = 32
 _MAX_NODES = 1_000_000
+MAX_STRING_CHARS = 16 * 1024 * 1024
+"""Characters of strings a script may hand to the host in all (each reference counts)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,52 +59,66 @@ def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> 
     """Copy ``value`` (a lupa value) into plain Python.
 
     ``lines`` is the sandbox's table -> line map. Tables nested deeper than 32 levels
-    (or cyclic), or more than a million values in all, raise FdlError.
+    (or cyclic), more than a million values or more than :data:`MAX_STRING_CHARS` characters
+    of strings in all (a string referenced twice counts twice) raise FdlError.
     """
-    from lupa import lua54
+    try:
+        return _Converter(lines, path).convert(value, 0, line)
+    except UnicodeDecodeError:
+        raise FdlError("a string is not valid UTF-8", path=path, line=line) from None
 
-    count = [0]
 
-    def convert(v: Any, depth: int, where: int | None) -> Any:
-        count[0] += 1
-        if count[0] > _MAX_NODES:
-            raise FdlError(f"script left more than {_MAX_NODES} values", path=path, line=where)
-        if v is None or isinstance(v, bool | int | float | str):
+class _Converter:
+    """One :func:`to_python` copy, counting the values and string characters it made."""
+
+    def __init__(self, lines: Any, path: str) -> None:
+        from lupa import lua54
+
+        self.lua_type = lua54.lua_type
+        self.lines = lines
+        self.path = path
+        self.values = 0
+        self.chars = 0
+
+    def fail(self, message: str, line: int | None) -> FdlError:
+        return FdlError(message, path=self.path, line=line)
+
+    def convert(self, v: Any, depth: int, where: int | None) -> Any:
+        self.values += 1
+        if self.values > _MAX_NODES:
+            raise self.fail(f"script left more than {_MAX_NODES} values", where)
+        if isinstance(v, str):
+            self.chars += len(v)
+            if self.chars > MAX_STRING_CHARS:
+                raise self.fail(f"script left more than {MAX_STRING_CHARS} characters of "
+                                "strings", where)
+            return v
+        if v is None or isinstance(v, bool | int | float):
             return v
         if isinstance(v, bytes):
-            raise FdlError("a string is not valid UTF-8", path=path, line=where)
-        kind = lua54.lua_type(v)
+            raise self.fail("a string is not valid UTF-8", where)
+        kind = self.lua_type(v)
         if kind != "table":
             return Opaque(kind or type(v).__name__)
-        own = lines[v]
+        return self.table(v, depth, where)
+
+    def table(self, v: Any, depth: int, where: int | None) -> LuaTable:
+        own = self.lines[v]
         here = int(own) if isinstance(own, int) else where
         if depth >= _MAX_DEPTH:
-            raise FdlError(
-                f"tables nested deeper than {_MAX_DEPTH} levels (a cycle?)", path=path, line=here
-            )
+            raise self.fail(f"tables nested deeper than {_MAX_DEPTH} levels (a cycle?)", here)
         numbered: dict[int, Any] = {}
         named: dict[str, Any] = {}
         for key, item in v.items():
             if isinstance(key, bool) or not isinstance(key, int | str):
-                raise FdlError(
-                    f"table key {key!r} is neither a name nor a position", path=path, line=here
-                )
+                raise self.fail(f"table key {key!r} is neither a name nor a position", here)
             if isinstance(key, int):
-                numbered[key] = convert(item, depth + 1, here)
+                numbered[key] = self.convert(item, depth + 1, here)
             else:
-                named[key] = convert(item, depth + 1, here)
+                named[key] = self.convert(item, depth + 1, here)
         n = len(numbered)
-        if numbered and set(numbered) != set(range(1, n + 1)):
-            gaps = sorted(set(range(1, max(numbered) + 1)) - set(numbered))[:3]
-            raise FdlError(
-                f"table has holes in its list part (missing positions {gaps})",
-                path=path,
-                line=here,
-            )
+        if numbered and (min(numbered) != 1 or max(numbered) != n):
+            gaps = [i for i in range(1, n + 4) if i not in numbered][:3]
+            raise self.fail(f"table has holes in its list part (missing positions {gaps})", here)
         items = tuple(numbered[i] for i in range(1, n + 1))
         return LuaTable(items=items, fields=named, line=here if own is not None else None)
-
-    try:
-        return convert(value, 0, line)
-    except UnicodeDecodeError:
-        raise FdlError("a string is not valid UTF-8", path=path, line=line) from None

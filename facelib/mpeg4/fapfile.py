@@ -20,14 +20,21 @@ Dialects the reader accepts (detected per file, reported as ``FapFile.dialect``)
 
 Lenient reading (``strict=False``) also takes ``#`` comment lines, frames missing from the
 file (the previous frame is held, with a warning) and masks that change between frames.
+
+Files from anywhere are read defensively: only regular files, line by line; the header's
+frame count is checked against the file's size before anything is allocated; numbers are
+ASCII only; FAP values must fit the format's 32-bit integers and FAP 1/2 fields their
+MPEG-4 ranges.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import re
+import stat
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,7 +42,13 @@ import numpy as np
 
 from facelib.atomic import write_text_atomic
 from facelib.errors import FacelibWarning, FapFormatError, ParameterError
-from facelib.mpeg4.stream import EXPRESSION_FIELDS, VISEME_FIELDS, FapStream
+from facelib.mpeg4.stream import (
+    EXPRESSION_FIELDS,
+    EXPRESSION_LIMITS,
+    VISEME_FIELDS,
+    VISEME_LIMITS,
+    FapStream,
+)
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
 __all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
@@ -43,6 +56,16 @@ __all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
 _GROUP = {0: len(VISEME_FIELDS), 1: len(EXPRESSION_FIELDS)}
+_FIELD_LIMITS = {0: VISEME_LIMITS, 1: EXPRESSION_LIMITS}
+VALUE_LIMIT = 2**31 - 1
+"""Largest magnitude of a FAP value in a ``.fap`` file (a 32-bit integer)."""
+_MIN_FRAME_BYTES = 2 * N_STANDARD_FAPS + 2
+"""Fewest bytes one frame takes: a 68-token mask line, a newline and a frame number line."""
+_HELD_PER_FRAME = 16
+"""A lenient file may declare up to this many frames per frame it could hold (the rest are
+held): a bound on what a header can make the reader allocate."""
+_INTEGER = re.compile(r"[0-9]+")
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 # One parsed frame: (frame number, values (84,) float32, mask (84,) bool,
 # viseme (4,) int16 or None, expression (6,) int16 or None).
@@ -68,11 +91,16 @@ class _Line:
     raw: str
 
 
-def _lines(text: str) -> Iterator[_Line]:
-    for number, raw in enumerate(text.splitlines(), start=1):
+def _lines(raw_lines: Iterable[bytes]) -> Iterator[_Line]:
+    """Non-blank lines with their 1-based numbers (UTF-8, else Latin-1 per line)."""
+    for number, data in enumerate(raw_lines, start=1):
+        try:
+            raw = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raw = data.decode("latin-1")
         tokens = raw.split()
         if tokens:
-            yield _Line(number, tokens, raw)
+            yield _Line(number, tokens, raw.rstrip("\r\n"))
 
 
 def read_fap(path: str | os.PathLike[str], *, strict: bool = False) -> FapStream:
@@ -99,20 +127,19 @@ def read_fap_file(path: str | os.PathLike[str], *, strict: bool = False) -> FapF
     """Read a ``.fap`` file with its header name, version and detected dialect."""
     path = Path(path)
     try:
-        data = path.read_bytes()
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):
+            raise FapFormatError("not a regular file (a folder, device or pipe?)", path=path)
+        with path.open("rb") as f:
+            return _Parser(path, info.st_size, strict=strict).parse(_lines(f))
     except OSError as exc:
         raise FapFormatError(f"cannot read the file: {exc.strerror}", path=path) from exc
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        text = data.decode("latin-1")
-    return _Parser(path, text, strict=strict).parse()
 
 
 class _Parser:
-    def __init__(self, path: Path, text: str, *, strict: bool):
+    def __init__(self, path: Path, size: int, *, strict: bool):
         self.path = path
-        self.text = text
+        self.size = size
         self.strict = strict
         self.float_values = False
 
@@ -120,38 +147,61 @@ class _Parser:
         number = line.number if isinstance(line, _Line) else line
         return FapFormatError(message, path=self.path, line=number)
 
-    def parse(self) -> FapFile:
-        lines = list(_lines(self.text))
-        comments = [ln for ln in lines if ln.tokens[0].startswith("#")]
-        if comments and self.strict:
-            raise self.error(comments[0], "comment lines are not allowed in strict mode")
-        lines = [ln for ln in lines if not ln.tokens[0].startswith("#")]
-        if not lines:
+    def content(self, lines: Iterator[_Line]) -> Iterator[_Line]:
+        for line in lines:
+            if not line.tokens[0].startswith("#"):
+                yield line
+            elif self.strict:
+                raise self.error(line, "comment lines are not allowed in strict mode")
+
+    def parse(self, lines: Iterator[_Line]) -> FapFile:
+        body = self.content(lines)
+        first = next(body, None)
+        if first is None:
             raise self.error(None, "the file is empty: expected a header line "
                              "'<version> <name> <fps> <n_frames>'")
-        version, name, fps, n_frames = self.header(lines[0])
-        body = lines[1:]
-        if len(body) % 2:
-            raise self.error(body[-1], "truncated frame: a mask line without its value line")
-        if not body:
+        version, name, fps, n_frames = self.header(first)
+        most = _HELD_PER_FRAME * (self.size // _MIN_FRAME_BYTES + 1)
+        if n_frames > most:
+            raise self.error(first, f"the header declares {n_frames} frames, but a file of "
+                             f"{self.size} bytes cannot describe more than {most}")
+        frames: list[_Frame]
+        frames, value_lines, width, dialect = [], [], 0, "standard"
+        for mask_line in body:
+            value_line = next(body, None)
+            if value_line is None:
+                raise self.error(mask_line, "truncated frame: a mask line without its value line")
+            if not frames:
+                width = len(mask_line.tokens)
+                dialect = self.dialect(mask_line, width, version)
+            frames.append(self.frame(mask_line, value_line, width, dialect))
+            value_lines.append(value_line)
+            if len(frames) > n_frames + 1:
+                raise self.error(value_line, f"more frames than the {n_frames} the header "
+                                 "declares")
+        if not frames:
             if n_frames:
-                raise self.error(lines[0], f"the header declares {n_frames} frames but "
+                raise self.error(first, f"the header declares {n_frames} frames but "
                                  "the file has none")
             return FapFile(FapStream.zeros(0, fps=fps), name, version, "standard", ())
-        width = len(body[0].tokens)
-        dialect = self.dialect(body[0], width, version)
-        frames = [self.frame(body[i], body[i + 1], width, dialect) for i in range(0, len(body), 2)]
-        one_based = frames[0][0] == 1 and max(f[0] for f in frames) == n_frames
-        if one_based:
+        frames, dialect = self.renumber(frames, value_lines[0], n_frames, dialect)
+        return self.assemble(frames, value_lines, fps=fps, n_frames=n_frames, name=name,
+                             version=version, dialect=dialect)
+
+    def renumber(
+        self, frames: list[_Frame], first: _Line, n_frames: int, dialect: str
+    ) -> tuple[list[_Frame], str]:
+        """Frames numbered from 0 and the final dialect: frames numbered from 1 are VREng's
+        (refused in strict mode), float values XFace's."""
+        if frames[0][0] == 1 and max(f[0] for f in frames) == n_frames:
             if self.strict:
-                raise self.error(body[1], "frame numbers must start at 0 in strict mode")
+                raise self.error(first, "frame numbers must start at 0 in strict mode")
             if dialect == "standard":
                 dialect = "vreng"
             frames = [(f[0] - 1, *f[1:]) for f in frames]
         if self.float_values and dialect == "standard":
             dialect = "xface"
-        return self.assemble(frames, body, fps=fps, n_frames=n_frames, name=name, version=version,
-                             dialect=dialect)
+        return frames, dialect
 
     def header(self, line: _Line) -> tuple[str, str, float, int]:
         expected = "expected '<version> <name> <fps> <n_frames>'"
@@ -162,9 +212,9 @@ class _Parser:
         name = " ".join(tokens[1:-2])
         if not _is_number(version):
             raise self.error(line, f"bad header version {version!r}: {expected}")
-        if not _is_number(fps_text) or not 0 < float(fps_text) < math.inf:
+        if not _is_number(fps_text) or not 0 < float(fps_text) <= 1000:
             raise self.error(line, f"bad frame rate {fps_text!r} in the header: {expected}")
-        if not count_text.isdigit():
+        if not _INTEGER.fullmatch(count_text):
             raise self.error(line, f"bad frame count {count_text!r} in the header: {expected}")
         if self.strict:
             if len(tokens) != 4:
@@ -194,7 +244,7 @@ class _Parser:
             raise self.error(mask_line, f"mask token {bad!r} is not 0 or 1")
         flags = np.array([t == "1" for t in mask_line.tokens])
         number_text, *tokens = value_line.tokens
-        if not number_text.isdigit():
+        if not _INTEGER.fullmatch(number_text):
             raise self.error(value_line, f"frame number {number_text!r} is not a "
                              "non-negative integer (is a mask or value line missing?)")
         groups = self.group_widths(flags, len(tokens), dialect)
@@ -211,6 +261,7 @@ class _Parser:
                 count = groups[slot]
                 field = [self.number(value_line, t, integer=True) for t in
                          tokens[position : position + count]]
+                self.check_fields(value_line, slot, field)
                 full = np.zeros(_GROUP[slot], np.int16)
                 full[:count] = field
                 viseme, expression = (full, expression) if slot == 0 else (viseme, full)
@@ -240,13 +291,20 @@ class _Parser:
             return single
         return full
 
+    def check_fields(self, line: _Line, slot: int, field: list[float]) -> None:
+        names = VISEME_FIELDS if slot == 0 else EXPRESSION_FIELDS
+        for name, value, high in zip(names, field, _FIELD_LIMITS[slot], strict=False):
+            if not 0 <= value <= high:
+                raise self.error(line, f"FAP {slot + 1} field {name} is {value:g}, outside "
+                                 f"0-{high}")
+
     def number(self, line: _Line, token: str, *, integer: bool) -> float:
-        try:
-            value = float(token)
-        except ValueError:
-            raise self.error(line, f"value {token!r} is not a number") from None
-        if not math.isfinite(value):
-            raise self.error(line, f"value {token!r} is not finite")
+        if not _NUMBER.fullmatch(token):
+            raise self.error(line, f"value {_short(token)!r} is not a number")
+        value = float(token)
+        if not abs(value) <= VALUE_LIMIT:
+            raise self.error(line, f"value {_short(token)!r} is outside the format's range "
+                             f"(+-{VALUE_LIMIT})")
         if not value.is_integer() or not token.lstrip("+-").isdigit():
             if integer or self.strict:
                 raise self.error(line, f"value {token!r} is not an integer")
@@ -254,7 +312,8 @@ class _Parser:
         return value
 
     def assemble(
-        self, frames: list[_Frame], body: list[_Line], *, fps: float, n_frames: int, name: str,
+        self, frames: list[_Frame], value_lines: list[_Line], *, fps: float, n_frames: int,
+        name: str,
         version: str, dialect: str,
     ) -> FapFile:
         values = np.zeros((n_frames, N_FAPS), np.float32)
@@ -265,7 +324,7 @@ class _Parser:
         any_viseme = any_expression = False
         previous = -1
         for index, (number, v, m, vis, expr) in enumerate(frames):
-            line = body[2 * index + 1]
+            line = value_lines[index]
             if number >= n_frames:
                 raise self.error(line, f"frame number {number} is outside the "
                                  f"{n_frames} frames the header declares")
@@ -294,10 +353,11 @@ class _Parser:
 
 
 def _is_number(text: str) -> bool:
-    try:
-        return math.isfinite(float(text))
-    except ValueError:
-        return False
+    return bool(_NUMBER.fullmatch(text)) and math.isfinite(float(text))
+
+
+def _short(text: str, limit: int = 40) -> str:
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def _spans(numbers: tuple[int, ...]) -> str:
@@ -347,6 +407,11 @@ def write_fap(
     label = "_".join((name if name is not None else path.stem).split()) or "facelib"
     width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
+    too_big = np.argwhere(np.abs(stream.values) > VALUE_LIMIT)
+    if too_big.size:
+        frame, column = (int(i) for i in too_big[0])
+        raise ParameterError(f"frame {frame} FAP {column + 1} is {stream.values[frame, column]:g},"
+                             f" beyond the .fap format's range (+-{VALUE_LIMIT})")
     values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
         str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
     first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
@@ -358,6 +423,18 @@ def write_fap(
         mask[:, 0] &= stream.viseme is not None
         mask[:, 1] &= stream.expression is not None
     out = [f"2.1 {label} {int(stream.fps)} {stream.n_frames}"]
+    out += _frame_lines(stream, mask, values, first=first, sep=sep)
+    write_text_atomic(path, "\n".join(out) + "\n")
+    return path
+
+
+def _frame_lines(
+    stream: FapStream, mask: np.ndarray, values: list[str], *, first: int, sep: str
+) -> list[str]:
+    """Mask and value lines of every frame: ``mask (n, width) bool`` says which FAPs are
+    written, ``values`` holds each value's text (frame-major, 84 per frame), frames are
+    numbered from ``first`` and tokens joined by ``sep``."""
+    out = []
     for i in range(stream.n_frames):
         out.append(sep.join("1" if m else "0" for m in mask[i]))
         tokens = [str(i + first)]
@@ -369,8 +446,7 @@ def write_fap(
             else:
                 tokens.append(values[i * N_FAPS + slot])
         out.append(sep.join(tokens))
-    write_text_atomic(path, "\n".join(out) + "\n")
-    return path
+    return out
 
 
 def _decimal(value: float) -> str:

@@ -16,6 +16,10 @@ __all__ = ["EXPRESSION_FIELDS", "VISEME_FIELDS", "FapStream", "check_fps"]
 VISEME_FIELDS = ("select1", "select2", "blend", "def")
 """Columns of ``FapStream.viseme`` (FAP 1): two viseme ids 0-14, blend 0-63, def flag."""
 EXPRESSION_FIELDS = ("select1", "intensity1", "select2", "intensity2", "init_face", "def")
+VISEME_LIMITS = (14, 14, 63, 1)
+"""Largest value of each of ``VISEME_FIELDS`` (ISO/IEC 14496-2: 15 visemes, 6-bit blend)."""
+EXPRESSION_LIMITS = (6, 63, 6, 63, 1, 1)
+"""Largest value of each of ``EXPRESSION_FIELDS`` (7 expressions, 6-bit intensities)."""
 """Columns of ``FapStream.expression`` (FAP 2): two expression ids 0-6 with intensities
 0-63, init_face and def flags."""
 
@@ -82,7 +86,8 @@ class FapStream:
         object.__setattr__(self, "fps", fps)
         object.__setattr__(self, "values", _frozen(values))
         object.__setattr__(self, "mask", _frozen(mask))
-        for name, width in (("viseme", len(VISEME_FIELDS)), ("expression", len(EXPRESSION_FIELDS))):
+        for name, limits in (("viseme", VISEME_LIMITS), ("expression", EXPRESSION_LIMITS)):
+            width = len(limits)
             data = getattr(self, name)
             if data is None:
                 continue
@@ -95,6 +100,11 @@ class FapStream:
                 data, np.round(data)
             ):
                 raise ParameterError(f"{name} fields must be integers")
+            outside = np.argwhere((data < 0) | (data > np.asarray(limits)))
+            if outside.size:
+                frame, column = (int(i) for i in outside[0])
+                raise ParameterError(f"{name} field {column} of frame {frame} is "
+                                     f"{data[frame, column]}, outside 0-{limits[column]}")
             object.__setattr__(self, name, _frozen(data.astype(np.int16)))
 
     # -- construction -----------------------------------------------------------------

@@ -19,6 +19,7 @@ from typing import Protocol
 
 import numpy as np
 
+from facelib.atomic import atomic_path, publish, temp_beside
 from facelib.checks import check_fps
 from facelib.errors import MissingExtraError, ParameterError, RenderError
 
@@ -74,24 +75,12 @@ def _publish(tmp: Path, *, directory: bool = False) -> None:
     tmp.chmod((0o777 if directory else 0o666) & ~_umask())
 
 
-def _atomic_bytes(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-        _publish(Path(tmp))
-        Path(tmp).replace(path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def save_png(image: np.ndarray, path: str | os.PathLike[str]) -> Path:
     """Write an ``(H, W, 3|4) uint8`` image to ``path`` as PNG, atomically; returns the path."""
-    path = Path(path)
-    _atomic_bytes(path, encode_png(image))
-    return path
+    data = encode_png(image)
+    with atomic_path(path) as temp:
+        temp.write_bytes(data)
+    return Path(path)
 
 
 # -- ffmpeg ------------------------------------------------------------------------------
@@ -139,18 +128,30 @@ class FrameWriter(Protocol):
 
 
 class _FfmpegWriter:
-    def __init__(self, path: Path, args: list[str], size: tuple[int, int], fps: float):
+    def __init__(self, path: Path, args: list[str], size: tuple[int, int], fps: float,
+                 *, audio: Path | None = None, audio_offset: float = 0.0):
         self.path = path
         self._size = size
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-        os.close(fd)
-        self._tmp = Path(tmp)
+        self._tmp = temp_beside(path)
+        self._wav = None
+        inputs = []
+        if audio is not None:
+            self._wav = temp_beside(path, suffix=".wav")
+            try:
+                _decode_audio(audio, self._wav)
+            except BaseException:
+                self._tmp.unlink(missing_ok=True)
+                self._wav.unlink(missing_ok=True)
+                raise
+            if audio_offset < 0:
+                inputs += ["-ss", f"{-audio_offset:.6f}"]
+            inputs += ["-f", "wav", "-i", str(self._wav)]
         width, height = size
         command = [
             ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y",
+            "-protocol_whitelist", "file,pipe",
             "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}",
-            "-framerate", f"{fps:.6g}", "-i", "pipe:0", *args, str(self._tmp),
+            "-framerate", f"{fps:.6g}", "-i", "pipe:0", *inputs, *args, str(self._tmp),
         ]
         self._log = tempfile.TemporaryFile()  # noqa: SIM115 (closed in commit/abort)
         self._proc = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
@@ -187,8 +188,9 @@ class _FfmpegWriter:
             self.abort()
             raise error
         self._log.close()
-        _publish(self._tmp)
-        self._tmp.replace(self.path)
+        if self._wav is not None:
+            self._wav.unlink(missing_ok=True)
+        publish(self._tmp, self.path)
         return self.path
 
     def abort(self) -> None:
@@ -197,6 +199,33 @@ class _FfmpegWriter:
             self._proc.wait()
         self._log.close()
         self._tmp.unlink(missing_ok=True)
+        if self._wav is not None:
+            self._wav.unlink(missing_ok=True)
+
+
+def _decode_audio(audio: Path, wav: Path) -> None:
+    """Decode ``audio`` with libsndfile (soundfile) into the 16-bit WAV ``wav``, in blocks.
+
+    ffmpeg is only ever given this WAV: a playlist, concat list or URL named as "audio"
+    never reaches its demuxers. ParameterError naming the file if it is not a regular file
+    libsndfile decodes.
+    """
+    import soundfile
+
+    if not audio.is_file():
+        raise ParameterError(f"audio file {str(audio)!r} does not exist or is not a file")
+    try:
+        with soundfile.SoundFile(str(audio)) as source:
+            if not 4000 <= source.samplerate <= 384_000:
+                raise ParameterError(f"audio file {str(audio)!r} has a sample rate of "
+                                     f"{source.samplerate} Hz, outside 4000-384000 Hz")
+            with soundfile.SoundFile(str(wav), "w", samplerate=source.samplerate,
+                                     channels=source.channels, subtype="PCM_16",
+                                     format="WAV") as out:
+                for block in source.blocks(blocksize=65536, dtype="float32"):
+                    out.write(block)
+    except (RuntimeError, soundfile.LibsndfileError) as exc:
+        raise ParameterError(f"audio file {str(audio)!r} cannot be decoded: {exc}") from None
 
 
 class _PngFolderWriter:
@@ -251,9 +280,10 @@ def open_writer(
 ) -> FrameWriter:
     """A writer for ``path`` chosen by its suffix.
 
-    ``.mp4``: H.264 (yuv420p, ``crf`` quality 0-51, lower is better), with ``audio`` (any
-    file ffmpeg reads) muxed as AAC, starting ``audio_offset`` seconds into the video
-    (negative skips the audio's beginning) and cut at ``duration`` seconds; ``.gif``: an
+    ``.mp4``: H.264 (yuv420p, ``crf`` quality 0-51, lower is better), with ``audio`` (a
+    sound file libsndfile decodes: WAV, FLAC, Ogg, MP3, ...) muxed as AAC, starting
+    ``audio_offset`` seconds into the video (negative skips the audio's beginning) and cut
+    at ``duration`` seconds; ``.gif``: an
     optimised-palette animated GIF (no audio); no suffix or an existing folder: one
     ``frame_NNNNNN.png`` per frame.
     """
@@ -267,15 +297,7 @@ def open_writer(
             raise ParameterError(
                 f"H.264 needs an even width and height, got {width}x{height}"
             )
-        args: list[str] = []
-        if audio is not None:
-            audio = Path(audio)
-            if not audio.is_file():
-                raise ParameterError(f"audio file {str(audio)!r} does not exist")
-            if audio_offset < 0:
-                args += ["-ss", f"{-audio_offset:.6f}"]
-            args += ["-i", str(audio)]
-        args += ["-map", "0:v:0"]
+        args = ["-map", "0:v:0"]
         if audio is not None:
             args += ["-map", "1:a:0", "-c:a", "aac", "-b:a", "160k"]
             if audio_offset > 0:
@@ -285,7 +307,9 @@ def open_writer(
                  "-pix_fmt", "yuv420p", "-movflags", "+faststart"]
         if duration is not None:
             args += ["-t", f"{duration:.6f}"]
-        return _FfmpegWriter(path, args, (width, height), fps)
+        return _FfmpegWriter(path, args, (width, height), fps,
+                             audio=None if audio is None else Path(audio),
+                             audio_offset=audio_offset)
     if suffix == ".gif":
         palette = "split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer"
         return _FfmpegWriter(path, ["-vf", palette, "-loop", "0"], (width, height), fps)

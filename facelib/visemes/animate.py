@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from facelib.checks import check_fps, check_number
-from facelib.cues import SpeechSpec
+from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
 from facelib.errors import SpeechError
 from facelib.mpeg4.track import FapTrack
 from facelib.speech import align as align_phones
@@ -81,24 +81,34 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0) -> SpeechTimeline:
             raise SpeechError(f"{exc.message} (speech of {speech.origin[0]}:"
                               f"{speech.origin[1]})", path=exc.path) from exc
     if speech.text:
+        if len(speech.text) > MAX_SPEECH_TEXT_CHARS:
+            path, line = speech.origin if speech.origin else (None, None)
+            raise SpeechError(f"speech text has {len(speech.text)} characters, more than "
+                              f"{MAX_SPEECH_TEXT_CHARS}", path=path, line=line)
         return timeline_from_text(speech.text, rate=rate)
     path, line = speech.origin if speech.origin else (None, None)
     raise SpeechError("speech has neither audio, text nor a viseme script", path=path, line=line)
 
 
-def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0) -> VisemeAnimation:
+def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
+            max_frames: int = MAX_FRAMES) -> VisemeAnimation:
     """Mouth, jaw and tongue FAP curves for ``speech``.
 
     Frame i of the track is at ``i / fps`` s of the storyboard; the track ends at the last
     frame inside the speech. Values come from the coarticulation blend of the viseme
     targets; weights are the speech envelope on the driven FAPs (0 elsewhere).
-    ``rate`` is the speaking rate of the text-only duration model.
+    ``rate`` is the speaking rate of the text-only duration model. Speech longer than
+    ``max_frames`` raises SpeechError before the curves are computed.
     """
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     timeline = speech_timeline(speech, rate=rate).shifted(speech.start_ms)
     end_ms = speech.start_ms + timeline.duration_ms
     n_frames = math.floor(end_ms * fps / 1000) + 1
+    if n_frames > max_frames:
+        path, line = speech.origin if speech.origin else (None, None)
+        raise SpeechError(f"speech lasts {end_ms} ms = {n_frames} frames at {fps:g} fps, more "
+                          f"than max_frames={max_frames}", path=path, line=line)
     times = frame_times_ms(n_frames, fps)
     values = blend(timeline.visemes, times)
     weight = np.zeros_like(values)

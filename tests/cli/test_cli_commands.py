@@ -10,7 +10,7 @@ from facelib import read_fap
 from facelib.cli import main
 
 ROOT = Path(__file__).parents[2]
-SMALL = ROOT / "tests" / "pipeline" / "data" / "small.fdl"
+SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 
 
 @pytest.fixture(autouse=True)

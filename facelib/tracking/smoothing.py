@@ -1,0 +1,49 @@
+"""The One Euro filter (Casiez, Roussel and Vogel, CHI 2012) over many signals at once.
+
+A low-pass filter whose cutoff rises with the signal's speed: ``fc = min_cutoff + beta *
+|dx/dt|``. A still face keeps a low cutoff (no jitter); a blink or a lip closure moves fast,
+raises the cutoff and keeps its depth and timing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facelib.checks import check_fps, check_number
+
+__all__ = ["one_euro"]
+
+
+def _alpha(cutoff: np.ndarray | float, dt: float) -> np.ndarray:
+    tau = 1.0 / (2.0 * np.pi * np.asarray(cutoff, np.float64))
+    return 1.0 / (1.0 + tau / dt)
+
+
+def one_euro(signal: np.ndarray, *, fps: float, min_cutoff: float = 1.5, beta: float = 0.5,
+             d_cutoff: float = 1.0) -> np.ndarray:
+    """Filter ``(n_frames, C)`` signals sampled at ``fps``; returns ``(n_frames, C) float64``.
+
+    Parameters
+    ----------
+    min_cutoff: Hz, the cutoff of a still signal (> 0).
+    beta: s per signal unit, how fast the cutoff rises with speed (>= 0).
+    d_cutoff: Hz, the cutoff of the speed estimate (> 0).
+
+    The first frame passes unchanged; the filter is causal (usable live).
+    """
+    dt = 1.0 / check_fps(fps)
+    min_cutoff = check_number("min_cutoff", min_cutoff, low=0, low_open=True)
+    beta = check_number("beta", beta, low=0)
+    d_cutoff = check_number("d_cutoff", d_cutoff, low=0, low_open=True)
+    x = np.asarray(signal, np.float64)
+    out = np.empty_like(x)
+    if len(x) == 0:
+        return out
+    a_d = _alpha(d_cutoff, dt)
+    prev = out[0] = x[0]
+    speed = np.zeros(x.shape[1:])
+    for i in range(1, len(x)):
+        speed = speed + a_d * ((x[i] - prev) / dt - speed)
+        a = _alpha(min_cutoff + beta * np.abs(speed), dt)
+        prev = out[i] = prev + a * (x[i] - prev)
+    return out

@@ -1,0 +1,141 @@
+"""Video in: frames decoded by the bundled ffmpeg (``imageio-ffmpeg``), faces tracked with
+MediaPipe, and the whole path from a video file to a FapStream.
+
+Frames where no face is found are NaN in the landmark track (interpolated later and named in
+a :class:`~facelib.errors.TrackingWarning`); frames with several faces keep the largest and
+are named too.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facelib.checks import check_count
+from facelib.errors import MissingExtraError, TrackingError, TrackingWarning
+from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
+from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+
+__all__ = ["VideoInfo", "VideoTrack", "read_video", "track_video", "track_video_faps"]
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    """A video's frame rate, frame size in pixels and whether it has sound."""
+
+    fps: float
+    width: int
+    height: int
+    audio: bool
+
+
+@dataclass(frozen=True)
+class VideoTrack:
+    """Landmarks of one video.
+
+    Attributes
+    ----------
+    path: the video.
+    info: its frame rate and size.
+    landmarks: ``(n_frames, 478, 3) float64`` pixels (column, row, depth); NaN where no
+        face was found.
+    n_faces: ``(n_frames,) int16`` faces seen per frame.
+    """
+
+    path: Path
+    info: VideoInfo
+    landmarks: np.ndarray
+    n_faces: np.ndarray
+
+    @property
+    def lost_frames(self) -> tuple[int, ...]:
+        """Frames with no face."""
+        return tuple(int(i) for i in np.flatnonzero(self.n_faces == 0))
+
+
+def _imageio_ffmpeg() -> Any:
+    try:
+        import imageio_ffmpeg
+    except ImportError as exc:
+        raise MissingExtraError("video input", "track", "imageio-ffmpeg") from exc
+    return imageio_ffmpeg
+
+
+def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.ndarray]]:
+    """The video's :class:`VideoInfo` and an iterator of ``(H, W, 3) uint8`` RGB frames.
+
+    TrackingError if the file is missing or ffmpeg finds no video stream in it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise TrackingError(f"video {str(path)!r} does not exist")
+    reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24")
+    try:
+        meta = next(reader)
+    except (OSError, RuntimeError, StopIteration) as exc:
+        reader.close()
+        raise TrackingError(f"ffmpeg cannot read a video stream from it ({exc})".splitlines()[0],
+                            path=path) from exc
+    fps = float(meta.get("fps") or 0)
+    width, height = (int(v) for v in meta["size"])
+    if not fps > 0:
+        reader.close()
+        raise TrackingError("the video has no frame rate", path=path)
+    info = VideoInfo(fps, width, height, bool(meta.get("audio_codec")))
+
+    def frames() -> Iterator[np.ndarray]:
+        try:
+            for raw in reader:
+                yield np.frombuffer(raw, np.uint8).reshape(height, width, 3)
+        finally:
+            reader.close()
+
+    return info, frames()
+
+
+def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
+                max_faces: int = 2) -> VideoTrack:
+    """Track the largest face through a video with MediaPipe's face mesh.
+
+    Raises TrackingError if the video has no frames or no face in any frame; warns
+    (:class:`TrackingWarning`) naming the frames with several faces.
+    """
+    info, frames = read_video(path)
+    limit = None if max_frames is None else check_count("max_frames", max_frames, low=1)
+    points: list[np.ndarray] = []
+    counts: list[int] = []
+    lost = np.full((N_LANDMARKS, 3), np.nan)
+    with FaceMeshTracker(video=True, max_faces=max_faces) as tracker:
+        for i, image in enumerate(frames):
+            if limit is not None and i >= limit:
+                break
+            found = tracker.detect(image)
+            points.append(lost if found is None else found.points)
+            counts.append(0 if found is None else found.n_faces)
+    if not points:
+        raise TrackingError("the video has no frames", path=Path(path))
+    n_faces = np.array(counts, np.int16)
+    if not n_faces.any():
+        raise TrackingError(f"no face found in any of its {len(points)} frames",
+                            path=Path(path))
+    several = np.flatnonzero(n_faces > 1)
+    if several.size:
+        warnings.warn(TrackingWarning(
+            f"{Path(path).name}: several faces in frames {frame_spans(several)}; tracked "
+            "the largest"), stacklevel=2)
+    return VideoTrack(Path(path), info, np.stack(points), n_faces)
+
+
+def track_video_faps(path: str | os.PathLike[str], *, max_frames: int | None = None,
+                     **options: Any) -> tuple[VideoTrack, TrackedFaps]:
+    """:func:`track_video`, then :func:`~facelib.tracking.faps.measure_faps` at the video's
+    frame rate (``options`` go to it: ``neutral``, ``fapu``, ``smooth``, ``states``)."""
+    track = track_video(path, max_frames=max_frames)
+    return track, measure_faps(track.landmarks, fps=track.info.fps, layout="mediapipe",
+                               **options)

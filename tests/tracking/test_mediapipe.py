@@ -1,0 +1,55 @@
+"""MediaPipe face mesh on facelib's own rendered head: 478 landmarks where the face is."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facelib.errors import ParameterError, TrackingError
+
+pytest.importorskip("mediapipe")
+pytestmark = pytest.mark.render
+
+from facelib.tracking.layouts import landmark_layout  # noqa: E402
+from facelib.tracking.mediapipe import FaceMeshTracker, detect_landmarks  # noqa: E402
+
+CLOSE = ("2.1", "2.2", "2.3", "2.6", "2.8", "3.1", "3.2", "3.3", "3.4", "3.5", "3.6", "4.1",
+         "4.2", "8.1", "8.2", "8.3", "8.4", "9.13", "9.14")
+
+
+def test_landmarks_fall_on_the_projected_feature_points(default_head_render):
+    image, projected = default_head_render
+    found = detect_landmarks(image)
+    assert found.points.shape == (478, 3)
+    assert found.n_faces == 1
+    layout = landmark_layout("mediapipe")
+    fps = layout.feature_point_positions(found.points[None])[0]
+    for fp in CLOSE:
+        error = np.linalg.norm(fps[layout.index(fp), :2] - projected[fp])
+        assert error < 8.0, (fp, error)
+    # the face's left (+x) is the image's right: left pupil right of the right pupil
+    assert fps[layout.index("3.5"), 0] > fps[layout.index("3.6"), 0]
+
+
+def test_two_faces_keeps_the_largest(default_head_render):
+    image, _ = default_head_render
+    from PIL import Image
+
+    small = np.asarray(Image.fromarray(image).resize((480, 360)))
+    canvas = np.concatenate([image, np.zeros_like(image)], axis=1)
+    canvas[60:420, 720:1200] = small
+    with FaceMeshTracker(video=False, max_faces=3) as tracker:
+        found = tracker.detect(canvas)
+    assert found is not None
+    assert found.n_faces == 2
+    assert found.box[2] < 640  # the big face, on the left half
+
+
+def test_no_face_and_bad_images():
+    blank = np.full((240, 320, 3), 40, np.uint8)
+    with pytest.raises(TrackingError, match="no face"):
+        detect_landmarks(blank)
+    with pytest.raises(ParameterError, match="uint8"):
+        detect_landmarks(blank.astype(np.float32))
+    with pytest.raises(ParameterError, match="shape"):
+        detect_landmarks(blank[..., 0])
