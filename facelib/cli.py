@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import facelib
-from facelib.errors import FacelibError
+from facelib.errors import FacelibError, FileError
 from facelib.mpeg4 import DIALECTS, FapStream, fap, read_fap, read_fap_file, write_fap
 
 if TYPE_CHECKING:
@@ -113,7 +113,10 @@ def _align(args: argparse.Namespace) -> int:
 
     text = args.text
     if args.text_file is not None:
-        text = Path(args.text_file).read_text(encoding="utf-8")
+        try:
+            text = Path(args.text_file).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise FileError(f"cannot read the transcript: {exc}", path=args.text_file) from exc
     out = write_timeline(align(args.audio, text), args.output, fps=args.fps)
     print(f"wrote {out}")
     return 0

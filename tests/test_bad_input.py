@@ -146,3 +146,33 @@ def test_the_table_names_each_error_class():
     named = {c[2] for c in CASES}
     assert {ParameterError, FdlError, FileError, DataError, FapFormatError,
             SpeechError} <= named
+
+
+# The command line: the same errors, reported on one line with exit status 1.
+CLI_CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
+    ("info missing", lambda tmp: ["info", str(tmp / "none.fap")], "none.fap"),
+    ("run missing", lambda tmp: ["run", str(tmp / "none.fdl")], "not found"),
+    ("run into a file", lambda tmp: ["run", str(_story(tmp)), "-o",
+                                      str(_a_file(tmp) / "x.fap")], "cannot write"),
+    ("align transcript missing", lambda tmp: ["align", str(tmp / "a.wav"), "--text-file",
+                                              str(tmp / "none.txt"), "-o", str(tmp / "o.sb")],
+     "none.txt: cannot read the transcript"),
+    ("check misspelt", lambda tmp: ["check", str(_story(tmp, 'shwo { "joy", dur = 1 }'))],
+     "did you mean 'show'"),
+]
+
+
+def _story(tmp: Path, text: str = 'show { "joy", dur = 1 }') -> Path:
+    return _write(tmp, "s.fdl", text)
+
+
+@pytest.mark.parametrize(("argv", "fragment"), [c[1:] for c in CLI_CASES],
+                         ids=[c[0] for c in CLI_CASES])
+def test_bad_input_on_the_command_line(tmp_path, capsys, argv, fragment):
+    from facelib.cli import main
+
+    assert main(argv(tmp_path)) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("facelib: error: ")
+    assert fragment in err
+    assert "Traceback" not in err
