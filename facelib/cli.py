@@ -19,6 +19,8 @@ if TYPE_CHECKING:
 
 __all__ = ["main"]
 
+_Commands = argparse._SubParsersAction  # what add_subparsers returns
+
 
 def _info(args: argparse.Namespace) -> int:
     file = read_fap_file(args.file, strict=args.strict)
@@ -194,7 +196,7 @@ def _track(args: argparse.Namespace) -> int:
     return 0
 
 
-def _add_track_command(commands: Any) -> None:
+def _add_track_command(commands: _Commands) -> None:
     track = commands.add_parser(
         "track", help="performance-driven animation: a face video (or landmarks) to FAPs")
     track.add_argument("source", help="a video, or landmarks: .csv (facelib/generic, "
@@ -282,7 +284,7 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _add_tool_commands(commands: Any) -> None:
+def _add_tool_commands(commands: _Commands) -> None:
     """The ``align`` and ``evaluate`` commands."""
     align = commands.add_parser("align", help="align speech audio to visemes")
     align.add_argument("audio", help="speech audio (any format soundfile reads)")

@@ -15,7 +15,7 @@ import logging
 import math
 import warnings
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TypeVar
 
 from facelib.checks import did_you_mean
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard
@@ -28,7 +28,7 @@ from facelib.fdl.paths import read_text, resolve_inside
 from facelib.fdl.sandbox import WHITELIST, ChunkResult, Sandbox
 from facelib.fdl.thesis import SCRIPT_GLOBALS, check_fdl_table
 from facelib.fdl.thesis_cues import ThesisList
-from facelib.fdl.values import LuaTable, to_python
+from facelib.fdl.values import LuaTable, LuaValue, to_python
 
 __all__ = ["load", "loads"]
 
@@ -126,7 +126,7 @@ def _line(text: str, name: str) -> int | None:
     return line_of_name(text, name)
 
 
-def _global(chunk: ChunkResult, key: str) -> Any:
+def _global(chunk: ChunkResult, key: str) -> LuaValue:
     value = chunk.env[key]
     return None if value is None else to_python(value, chunk.lines, path=chunk.path)
 
@@ -243,7 +243,7 @@ def _output_line(ctx: Context, fdl: dict[str, str | None] | None, fdl_line: int 
     return _line(ctx.source, "output")
 
 
-def _calls(chunk: ChunkResult) -> list[tuple[str, object, int | None, int]]:
+def _calls(chunk: ChunkResult) -> list[tuple[str, LuaValue, int | None, int]]:
     """The storyboard-function calls the sandbox recorded: (function, argument, line,
     number of arguments)."""
     calls = []

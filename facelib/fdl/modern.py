@@ -19,7 +19,7 @@ from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.context import Context
 from facelib.fdl.timing import parse_time
-from facelib.fdl.values import LuaTable, lua_kind
+from facelib.fdl.values import LuaTable, LuaValue, lua_kind
 from facelib.mpeg4.tables import fap_table
 
 if TYPE_CHECKING:
@@ -216,13 +216,15 @@ def read_say(
         return
     t = _table(arg, "say", ctx, line, allowed=fn.fields)
     f = t.fields
-    if len(t.items) > 1 or (t.items and not isinstance(t.items[0], str)):
+    first = t.items[0] if t.items else None
+    if len(t.items) > 1 or (t.items and not isinstance(first, str)):
         raise FdlError(
             "say takes the spoken text first, then named fields (audio = ..., at = ...)",
             path=ctx.path,
             line=line,
         )
-    text = t.items[0] if t.items else f.get("text")
+    strings = {key: _string(f, key, "say", ctx, line) for key in ("text", "transcript", "audio")}
+    text = first if isinstance(first, str) else strings["text"]
     if t.items and "text" in f:
         raise FdlError(
             "say: the text is given twice (first value and text =)", path=ctx.path, line=line
@@ -231,9 +233,6 @@ def read_say(
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
-    for key in ("text", "transcript", "audio"):
-        if key in f and not isinstance(f[key], str):
-            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
@@ -241,10 +240,20 @@ def read_say(
         line=line,
         at_ms=_opt_time(f, "at", "say", ctx, line) or 0,
         text=text,
-        transcript=f.get("transcript"),
-        audio=f.get("audio"),
+        transcript=strings["transcript"],
+        audio=strings["audio"],
         visemes=visemes,
     )
+
+
+def _string(
+    fields: Mapping[str, LuaValue], key: str, fn: str, ctx: Context, line: int | None
+) -> str | None:
+    """Field ``key`` as a string (None when absent); FdlError if it is something else."""
+    value = fields.get(key)
+    if value is not None and not isinstance(value, str):
+        raise FdlError(f"{fn}: {key} must be a string; got {value!r}", path=ctx.path, line=line)
+    return value
 
 
 def _visemes(
@@ -369,12 +378,11 @@ def read_define_gaze(
     for key, value in t.fields.items():
         if isinstance(value, str | bool | int | float):
             params[key] = value if isinstance(value, str | bool) else float(value)
-        elif (
-            isinstance(value, LuaTable)
-            and not value.fields
-            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value.items)
-        ):
-            params[key] = tuple(float(v) for v in value.items)
+        elif isinstance(value, LuaTable) and not value.fields and len(
+            numbers := [v for v in value.items
+                        if isinstance(v, int | float) and not isinstance(v, bool)]
+        ) == len(value.items):
+            params[key] = tuple(float(v) for v in numbers)
         else:
             raise FdlError(
                 f"define_gaze {{ {name!r} }}: parameter {key} must be a string, number, "
