@@ -80,6 +80,16 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
     ("timeline fps 0", lambda _: visemes.timeline_to_sentence(
         visemes.timeline_from_text("hi"), fps=0),
      ParameterError, "fps must be a positive number"),
+    # storyboards: API arguments are ParameterErrors, script problems FdlErrors
+    ("loads bytes", lambda _: fdl.loads(b"show {}"), ParameterError, "must be a str"),
+    ("loads base_dir", lambda tmp: fdl.loads("x = 1", base_dir=_a_file(tmp)),
+     ParameterError, "is not a folder"),
+    ("sandbox memory", lambda _: fdl.Sandbox(max_memory=10),
+     ParameterError, "max_memory must be an integer >= 1048576"),
+    ("sandbox seconds", lambda _: fdl.Sandbox(max_seconds=0),
+     ParameterError, "max_seconds must be a finite number in (0, 3600]"),
+    ("script line", lambda _: fdl.loads("x = 1\nfps = -5", name="s.fdl"),
+     FdlError, "s.fdl:2: fps must be a number from 1 to 1000"),
     # streams and tracks
     ("stream shape", lambda _: FapStream(25, np.zeros((2, 80))),
      ParameterError, "values must have shape (n_frames, 84)"),

@@ -19,7 +19,7 @@ from typing import TypeVar
 
 from facelib.checks import did_you_mean
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard
-from facelib.errors import FdlError, FdlWarning
+from facelib.errors import FdlError, FdlWarning, ParameterError
 from facelib.fdl import modern_cues, thesis_cues
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.functions import SETTINGS, function_names, known_globals, read_calls
@@ -75,10 +75,10 @@ def loads(
     File names in the script resolve relative to ``base_dir`` (none allowed without it).
     """
     if not isinstance(text, str):
-        raise FdlError(f"storyboard text must be a str, got {type(text).__name__}", path=name)
+        raise ParameterError(f"storyboard text must be a str, got {type(text).__name__}")
     folder = None if base_dir is None else Path(base_dir)
     if folder is not None and not folder.is_dir():
-        raise FdlError(f"base_dir {str(base_dir)!r} is not a folder", path=name)
+        raise ParameterError(f"base_dir {str(base_dir)!r} is not a folder")
     return _load(text, name=name, base_dir=folder, seed=seed, file=None, sandbox=sandbox)
 
 
