@@ -252,7 +252,11 @@ class Face:
 
     def deform_frame(self, values: np.ndarray) -> np.ndarray:
         """Vertex positions for one frame of 84 FAP values: ``(84,) -> (V, 3) float32``."""
-        values = np.asarray(values, dtype=np.float32)
+        try:
+            values = np.asarray(values, dtype=np.float32)
+        except (TypeError, ValueError):
+            raise ParameterError(f"deform_frame() needs 84 FAP values, got {values!r:.60}"
+                                 ) from None
         if values.shape != (N_FAPS,):
             raise ParameterError(f"deform_frame() needs 84 FAP values, got shape {values.shape}")
         if not np.all(np.isfinite(values)):

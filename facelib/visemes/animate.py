@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.checks import check_fps, check_number
+from facelib.checks import check_fps, check_kind, check_number
 from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
 from facelib.errors import SpeechError
 from facelib.mpeg4.track import FapTrack
@@ -100,6 +100,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     ``rate`` is the speaking rate of the text-only duration model. Speech longer than
     ``max_frames`` raises SpeechError before the curves are computed.
     """
+    speech = check_kind("speech", speech, SpeechSpec)
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     timeline = speech_timeline(speech, rate=rate).shifted(speech.start_ms)
