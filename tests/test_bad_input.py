@@ -184,6 +184,9 @@ CLI_CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
      "none.txt: cannot read the transcript"),
     ("check misspelt", lambda tmp: ["check", str(_story(tmp, 'shwo { "joy", dur = 1 }'))],
      "did you mean 'show'"),
+    ("run misspelt expression", lambda tmp: ["run", str(_story(tmp, 'show { "joyy", dur = 1 }')),
+                                             "-o", str(tmp / "o.fap")],
+     "s.fdl:1: unknown expression 'joyy'; did you mean 'joy'?"),
 ]
 
 
