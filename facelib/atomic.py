@@ -18,7 +18,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from facelib.errors import FileError, ParameterError
+from facelib.errors import FileError
 
 __all__ = ["atomic_path", "check_output_path", "publish", "temp_beside", "write_text_atomic"]
 
@@ -26,11 +26,11 @@ _TEMP = re.compile(r"^\..+\.(?P<pid>[0-9]+)\.[A-Za-z0-9_]{8}(\.[^.]*)?$")
 
 
 def check_output_path(path: str | os.PathLike[str]) -> Path:
-    """``path`` as a Path, if a file may be written there; ParameterError naming it if it is
+    """``path`` as a Path, if a file may be written there; FileError naming it if it is
     empty, an existing folder, device, pipe or symbolic link, or in a parent that is a file."""
     text = os.fspath(path)
     if not str(text).strip():
-        raise ParameterError("the output path is empty")
+        raise FileError("the output path is empty")
     target = Path(text)
     try:
         info = target.lstat()
@@ -41,7 +41,7 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     if info is not None and not stat.S_ISREG(info.st_mode):
         kind = ("a folder" if stat.S_ISDIR(info.st_mode) else "a symbolic link"
                 if stat.S_ISLNK(info.st_mode) else "a device or pipe")
-        raise ParameterError(f"will not replace {str(target)!r}: it is {kind}, not a file")
+        raise FileError(f"will not replace it: it is {kind}, not a file", path=target)
     return target
 
 
@@ -71,8 +71,8 @@ def temp_beside(path: str | os.PathLike[str], *, suffix: str | None = None) -> P
     """A new empty temporary file beside ``path`` (its folder created), named so that a later
     write can sweep it if this process dies; ``suffix`` defaults to ``path``'s.
 
-    Raises ParameterError if ``path`` is not a place a file may be written
-    (:func:`check_output_path`), FileError naming it if the folder cannot be written.
+    Raises FileError if ``path`` is not a place a file may be written
+    (:func:`check_output_path`) or the folder cannot be written.
     """
     path = check_output_path(path)
     try:
@@ -81,7 +81,7 @@ def temp_beside(path: str | os.PathLike[str], *, suffix: str | None = None) -> P
         handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.{os.getpid()}.",
                                         suffix=path.suffix if suffix is None else suffix)
     except OSError as exc:
-        raise FileError.wrap(exc, "write", path) from exc
+        raise FileError.wrap(exc, "write", Path(path)) from exc
     os.close(handle)
     return Path(name)
 
@@ -99,11 +99,12 @@ def publish(temp: Path, path: str | os.PathLike[str]) -> Path:
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same suffix); on success rename it onto
-    ``path``, on any error (KeyboardInterrupt included) remove it.
+    ``path``, on any error (KeyboardInterrupt included) remove it. The file gets the usual
+    permissions (0666 less the umask).
 
-    Raises ParameterError if ``path`` is not a place a file may be written
-    (:func:`check_output_path`), FileError (an ``OSError``) naming ``path`` if its folder
-    cannot be created or the rename fails.
+    Raises FileError naming ``path`` if it is not a place a file may be written
+    (:func:`check_output_path`), its folder cannot be created, or writing fails with an
+    ``OSError`` (no permission, disk full, ...).
 
     >>> with atomic_path("out.mp4") as temp:   # doctest: +SKIP
     ...     encode_video(temp)
@@ -111,22 +112,19 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     temp = temp_beside(path)
     try:
         yield temp
-        try:
-            publish(temp, path)
-        except OSError as exc:
-            if isinstance(exc, FileError):
-                raise
-            raise FileError.wrap(exc, "write", path) from exc
+        publish(temp, path)
+    except OSError as exc:
+        temp.unlink(missing_ok=True)
+        if isinstance(exc, FileError):
+            raise
+        raise FileError.wrap(exc, "write", Path(path)) from exc
     except BaseException:
         temp.unlink(missing_ok=True)
         raise
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically; FileError naming
-    the path when it cannot be written (full disk, read-only folder, ...)."""
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically (see
+    :func:`atomic_path` for the errors)."""
     with atomic_path(path) as temp:
-        try:
-            temp.write_text(text, encoding="utf-8", newline="\n")
-        except OSError as exc:
-            raise FileError.wrap(exc, "write", path) from exc
+        temp.write_text(text, encoding="utf-8", newline="\n")

@@ -7,7 +7,6 @@ the file and line it came from.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 __all__ = [
@@ -83,21 +82,19 @@ class RenderError(FacelibError):
     """Rendering or video encoding failed (no OpenGL platform, encoder error, ...)."""
 
 
+class TrackingError(FacelibError):
+    """A video or landmark track cannot be turned into FAPs (no face, unreadable video,
+    wrong point count, missing feature points); the message names the frames."""
 class FileError(FacelibError, OSError):
     """A file or folder could not be read or written: the operating system's error
     (``OSError``, kept as ``__cause__``) with the path it concerns."""
 
     @classmethod
-    def wrap(cls, exc: OSError, what: str, path: str | os.PathLike[str]) -> FileError:
+    def wrap(cls, exc: OSError, what: str, path: str | Path) -> FileError:
         """``FileError`` for ``exc`` raised while doing ``what`` ("write", "read") at
         ``path``."""
         reason = exc.strerror or str(exc)
-        return cls(f"cannot {what}: {reason}", path=os.fspath(path))
-
-
-class TrackingError(FacelibError):
-    """A video or landmark track cannot be turned into FAPs (no face, unreadable video,
-    wrong point count, missing feature points); the message names the frames."""
+        return cls(f"cannot {what}: {reason}", path=path)
 
 
 class MissingExtraError(FacelibError, ImportError):

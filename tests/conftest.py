@@ -1,4 +1,4 @@
-"""Fixtures shared by the whole test tree: a seeded random generator, the builders that
+"""Fixtures shared by the whole test tree: a seeded random generator and the builders that
 tests used to re-declare per file (FAP frames and streams, the default head), and a memory
 cap for hostile-input tests."""
 
@@ -14,6 +14,36 @@ import pytest
 
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap
+
+HOSTILE_HEADROOM = 1536 * 1024 * 1024
+"""Address space a hostile-input test may add to the process (1.5 GiB)."""
+
+
+def _virtual_size() -> int:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmSize:"):
+            return int(line.split()[1]) * 1024
+    return 0
+
+
+@pytest.fixture
+def memory_cap() -> Iterator[None]:
+    """Cap the process's address space at its current size plus 1.5 GiB for one test, so a
+    regression in a hostile-input test fails with MemoryError instead of swamping the
+    machine; the previous limit is restored afterwards."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    size = _virtual_size()
+    if not size:
+        pytest.skip("no /proc/self/status to measure the address space")
+    cap = size + HOSTILE_HEADROOM
+    if hard != resource.RLIM_INFINITY:
+        cap = min(cap, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
 
 FapFrame = Callable[..., np.ndarray]
 FapStreamBuilder = Callable[..., FapStream]
@@ -69,33 +99,3 @@ def default_face():  # -> facelib.engine.Face
     from facelib.engine import load_face
 
     return load_face()
-
-
-HOSTILE_HEADROOM = 1536 * 1024 * 1024
-"""Address space a hostile-input test may add to the process (1.5 GiB)."""
-
-
-def _virtual_size() -> int:
-    for line in Path("/proc/self/status").read_text().splitlines():
-        if line.startswith("VmSize:"):
-            return int(line.split()[1]) * 1024
-    return 0
-
-
-@pytest.fixture
-def memory_cap() -> Iterator[None]:
-    """Cap the process's address space at its current size plus 1.5 GiB for one test, so a
-    regression in a hostile-input test fails with MemoryError instead of swamping the
-    machine; the previous limit is restored afterwards."""
-    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-    size = _virtual_size()
-    if not size:
-        pytest.skip("no /proc/self/status to measure the address space")
-    cap = size + HOSTILE_HEADROOM
-    if hard != resource.RLIM_INFINITY:
-        cap = min(cap, hard)
-    resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
-    try:
-        yield
-    finally:
-        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))

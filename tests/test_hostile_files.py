@@ -65,7 +65,7 @@ def test_outputs_never_replace_special_files(tmp_path, kind):
         target.mkdir()
     else:
         target = ""
-    with pytest.raises(ParameterError, match=r"will not replace|empty"):
+    with pytest.raises(FileError, match=r"will not replace|empty"):
         write_fap(stream, target)
     assert Path("/dev/null").exists() and not Path("/dev/null").is_file()
     if kind == "symlink":

@@ -136,8 +136,8 @@ class _Reader:
     def mesh(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         mesh_path = self.path.parent / self.get("mesh", str)
         try:
-            with np.load(mesh_path, allow_pickle=False) as arrays_file:
-                arrays = {k: arrays_file[k] for k in ("vertices", "triangles", "vertex_colors")}
+            with np.load(mesh_path, allow_pickle=False) as data:
+                arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
         except (OSError, ValueError) as exc:
             raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
         except KeyError as exc:
@@ -242,11 +242,9 @@ class _Reader:
                                  f"of {self.path.name} (known: {', '.join(known)})")
         return tuple(out)
 
-    def region(
-        self, item: dict[str, Any], nv: int, points: dict[str, int],
-        pivots: dict[str, np.ndarray],
-    ) -> Region:
-        """One entry of ``regions`` (an object with a string ``name``)."""
+    def region(self, item: dict, nv: int, points: dict[str, int],
+               pivots: dict[str, np.ndarray]) -> Region:
+        """One region of the definition, validated, with its deformer resolved."""
         name = item["name"]
         where = f"region {name!r}"
         group = item.get("group", "")
@@ -260,35 +258,26 @@ class _Reader:
             if c not in points:
                 raise self.fail(f"{where} uses feature point {c!r}, which the face lacks")
         vertices = self.indices(item.get("vertices"), nv, f"{where} vertices")
-        anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors", allow_empty=True)
+        anchors = self.indices(item.get("anchors", []), nv, f"{where} anchors",
+                               allow_empty=True)
         deformer = ALIASES.get(deformer_name, deformer_name)
         if deformer == "rbf" and len(controls) + anchors.size < 2:
             raise self.fail(f"{where}: an RBF needs at least two sources")
-        weights, pivot = self.rigid_fields(item, deformer, where, n_controls=len(controls),
-                                           vertices=vertices, pivots=pivots)
-        return Region(name=name, deformer=deformer, feature_points=tuple(controls),
-                      vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
-                      pivot=pivot, params=MappingProxyType(params), group=group, custom=custom)
-
-    def rigid_fields(
-        self, item: dict[str, Any], deformer: str, where: str, *, n_controls: int,
-        vertices: np.ndarray, pivots: dict[str, np.ndarray],
-    ) -> tuple[np.ndarray, str]:
-        """``weights`` ((Vr,), for weights and eyelid regions, else empty) and ``pivot`` (for
-        eyelid regions, else "") of a region entry."""
         weights = np.zeros(0, np.float32)
-        pivot = ""
         if deformer in ("weights", "eyelid"):
-            if n_controls != 1:
+            if len(controls) != 1:
                 raise self.fail(f"{where}: a {deformer} region has exactly one feature point")
             weights = np.asarray(item.get("weights", []), dtype=np.float64)
             if weights.shape != vertices.shape or not np.all((weights >= 0) & (weights <= 1)):
                 raise self.fail(f"{where}: weights must be {vertices.size} numbers in [0, 1]")
+        pivot = ""
         if deformer == "eyelid":
             pivot = str(item.get("pivot"))
             if pivot not in pivots:
                 raise self.fail(f"{where} has pivot {pivot!r}; known: {tuple(pivots)}")
-        return weights, pivot
+        return Region(name=name, deformer=deformer, feature_points=tuple(controls),
+                      vertices=vertices, anchors=anchors, weights=weights.astype(np.float32),
+                      pivot=pivot, params=MappingProxyType(params), group=group, custom=custom)
 
     def deformer_of(self, item: dict, name: str, group: str, where: str
                     ) -> tuple[str, Deformer | None, dict[str, Any]]:

@@ -221,8 +221,17 @@ class Face:
         part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
         operator, steps = _compile(verts, tris, points, fapu, regions)
-        _check_eyes_rigid(regions, part_map)
+        for region in regions:
+            for eye in ("eye_l", "eye_r"):
+                if np.isin(region.vertices, part_map[eye].vertex_ids).any():
+                    raise FaceModelError(
+                        f"region {region.name!r} contains vertices of {eye}; eyeballs are "
+                        "rigid and move only with FAP 23-28"
+                    )
         columns = np.unique(operator.indices).astype(np.int64)
+        dense = operator[:, columns].toarray().astype(np.float32)
+        rigid_parts = _rigid(verts, points, fapu, regions=regions, parts=part_map,
+                             pivots=pivot_map, neck=neck)
         return cls(
             vertices=verts,
             triangles=tris,
@@ -234,11 +243,16 @@ class Face:
             pivots=MappingProxyType(pivot_map),
             operator=operator,
             _columns=columns,
-            _dense=operator[:, columns].toarray().astype(np.float32),
-            _rigid=_rigid(verts, points=points, fapu=fapu, regions=regions, parts=part_map,
-                          pivots=pivot_map, neck=neck),
+            _dense=dense,
+            _rigid=rigid_parts,
             _steps=steps,
         )
+
+    def __repr__(self) -> str:
+        """One line: sizes and names, never the arrays."""
+        return (f"Face(vertices={len(self.vertices)}, triangles={len(self.triangles)}, "
+                f"parts=[{', '.join(self.parts)}], feature_points={len(self.feature_points)}, "
+                f"regions={len(self.regions)})")
 
     @property
     def n_vertices(self) -> int:
@@ -476,8 +490,9 @@ def _lids(
                  centres[:, 2], weights)
 
 
-def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int) -> dict[str, Part]:
-    """Parts with read-only vertex ids and the triangles whose corners all lie in them."""
+def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
+           ) -> dict[str, Part]:
+    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it."""
     out = {}
     for name, part_ids in parts.items():
         ids = _readonly(part_ids, np.int32)
@@ -487,31 +502,18 @@ def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int) -
     return out
 
 
-def _check_eyes_rigid(regions: tuple[Region, ...], parts: Mapping[str, Part]) -> None:
-    """FaceModelError if a region would deform an eyeball (they only rotate, step 3)."""
-    for region in regions:
-        for eye in ("eye_l", "eye_r"):
-            if np.isin(region.vertices, parts[eye].vertex_ids).any():
-                raise FaceModelError(
-                    f"region {region.name!r} contains vertices of {eye}; eyeballs are "
-                    "rigid and move only with FAP 23-28"
-                )
-
-
-def _rigid(
-    verts: np.ndarray, *, points: Mapping[str, int], fapu: Mapping[str, float],
-    regions: tuple[Region, ...], parts: Mapping[str, Part],
-    pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float],
-) -> _Rigid:
-    """Precompute steps 2-5. The head's weight fades with a smoothstep over ``neck``'s
-    blend distance above its plane."""
+def _rigid(verts: np.ndarray, points: Mapping[str, int], fapu: Mapping[str, float], *,
+           regions: tuple[Region, ...], parts: Mapping[str, Part],
+           pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float]
+           ) -> _Rigid:
+    """The rigid steps' precomputed columns, offsets and weights (eyes, lids, jaw, head)."""
     head = pivots["head"]
     point, normal, blend = neck
     height = (verts.astype(np.float64) - point) @ normal
     t = np.clip(height / blend, 0.0, 1.0)
     head_w = t * t * (3 - 2 * t)
-    jaw_ids = np.concatenate([parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
-    chin = fap(_JAW[0]).feature_points[0]
+    jaw_ids = np.concatenate(
+        [parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
     return _Rigid(
         lids=_lids(verts, points, fapu, regions, pivots),
         eyes=tuple(
@@ -525,7 +527,7 @@ def _rigid(
         jaw_y=_columns(jaw_ids, "y"),
         jaw_z=_columns(jaw_ids, "z"),
         jaw_pivot=pivots["jaw"],
-        chin=verts[points[chin]].astype(np.float64),
+        chin=verts[points[fap(_JAW[0]).feature_points[0]]].astype(np.float64),
         head_pivot=head,
         head_tiled=np.tile(head.astype(np.float32), len(verts)),
         head_weights=head_w[head_w < 1.0].astype(np.float32),

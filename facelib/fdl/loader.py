@@ -194,8 +194,7 @@ def _build(
     speech = _speech(fdl, fdl_line, lists.get("Sentence"), parts, ctx)
     output = _output(chunk, fdl, fdl_line, ctx)
     if output is not None:
-        _check_output(output, inputs=(file, *_inputs_of(speech)), path=name,
-                      line=_output_line(ctx, fdl, fdl_line))
+        _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
     return Storyboard(
         path=file,
         fps=fps,
@@ -221,26 +220,19 @@ def _inputs_of(speech: SpeechSpec | None) -> tuple[Path, ...]:
     return (Path(speech.audio),)
 
 
-def _check_output(output: Path, *, inputs: tuple[Path | None, ...], path: str,
-                  line: int | None) -> None:
+def _check_output(output: Path, *, inputs: tuple[Path | None, ...], ctx: Context) -> None:
     """A storyboard may only name an output facelib writes: a known suffix, not a hidden
     file, not the storyboard itself or a file it reads."""
+    line = _line(ctx.source, "output")
     if output.suffix.lower() not in OUTPUT_SUFFIXES:
         raise FdlError(f"output {output.name!r} must end in one of {', '.join(OUTPUT_SUFFIXES)}",
-                       path=path, line=line)
+                       path=ctx.path, line=line)
     if output.name.startswith("."):
-        raise FdlError(f"output {output.name!r} must not be a hidden file", path=path, line=line)
+        raise FdlError(f"output {output.name!r} must not be a hidden file", path=ctx.path,
+                       line=line)
     if any(source is not None and output == source.resolve() for source in inputs):
         raise FdlError(f"output {output.name!r} would overwrite one of the storyboard's inputs",
-                       path=path, line=line)
-
-
-def _output_line(ctx: Context, fdl: dict[str, str | None] | None, fdl_line: int | None
-                 ) -> int | None:
-    """The line that sets the output: ``FDL.output`` or the global."""
-    if fdl is not None and "output" in fdl:
-        return ctx.line_of("output", after=fdl_line)
-    return _line(ctx.source, "output")
+                       path=ctx.path, line=line)
 
 
 def _calls(chunk: ChunkResult) -> list[tuple[str, LuaValue, int | None, int]]:

@@ -30,8 +30,8 @@ class Opaque:
 
 @dataclass(frozen=True, slots=True)
 class LuaTable:
-    """A Lua table: ``items`` holds keys 1..n in order, ``fields`` the string keys,
-    ``line`` the line of its constructor (None when no constructor made it)."""
+    """A Lua table: ``items`` holds keys 1..n in order, ``fields`` the string keys (in name
+    order), ``line`` the line of its constructor (None when no constructor made it)."""
 
     items: tuple[LuaValue, ...] = ()
     fields: dict[str, LuaValue] = field(default_factory=dict)
@@ -67,13 +67,13 @@ def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> 
     of strings in all (a string referenced twice counts twice) raise FdlError.
     """
     try:
-        return _Converter(lines, path).convert(value, 0, line)
+        return _Copier(lines, path).value(value, 0, line)
     except UnicodeDecodeError:
         raise FdlError("a string is not valid UTF-8", path=path, line=line) from None
 
 
-class _Converter:
-    """One :func:`to_python` copy, counting the values and string characters it made."""
+class _Copier:
+    """One copy out of Lua, with its budgets of values and string characters."""
 
     def __init__(self, lines: Any, path: str) -> None:
         from lupa import lua54
@@ -87,7 +87,7 @@ class _Converter:
     def fail(self, message: str, line: int | None) -> FdlError:
         return FdlError(message, path=self.path, line=line)
 
-    def convert(self, v: Any, depth: int, where: int | None) -> LuaValue:
+    def value(self, v: Any, depth: int, where: int | None) -> LuaValue:
         self.values += 1
         if self.values > _MAX_NODES:
             raise self.fail(f"script left more than {_MAX_NODES} values", where)
@@ -117,12 +117,15 @@ class _Converter:
             if isinstance(key, bool) or not isinstance(key, int | str):
                 raise self.fail(f"table key {key!r} is neither a name nor a position", here)
             if isinstance(key, int):
-                numbered[key] = self.convert(item, depth + 1, here)
+                numbered[key] = self.value(item, depth + 1, here)
             else:
-                named[key] = self.convert(item, depth + 1, here)
+                named[key] = self.value(item, depth + 1, here)
         n = len(numbered)
         if numbered and (min(numbered) != 1 or max(numbered) != n):
             gaps = [i for i in range(1, n + 4) if i not in numbered][:3]
             raise self.fail(f"table has holes in its list part (missing positions {gaps})", here)
         items = tuple(numbered[i] for i in range(1, n + 1))
-        return LuaTable(items=items, fields=named, line=here if own is not None else None)
+        # Lua's hash order differs between Lua states: fields go in name order, so the same
+        # script gives the same storyboard (and reports the same first mistake) every time.
+        fields = dict(sorted(named.items()))
+        return LuaTable(items=items, fields=fields, line=here if own is not None else None)

@@ -52,7 +52,7 @@ from facelib.mpeg4.stream import (
 )
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
-__all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
+__all__ = ["DIALECTS", "FapFile", "format_fap", "read_fap", "read_fap_file", "write_fap"]
 
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
@@ -166,8 +166,30 @@ class _Parser:
         if n_frames > most:
             raise self.error(first, f"the header declares {n_frames} frames, but a file of "
                              f"{self.size} bytes cannot describe more than {most}")
-        frames: list[_Frame]
-        frames, value_lines, width, dialect = [], [], 0, "standard"
+        frames, value_lines, dialect = self.frames(body, n_frames, version)
+        if not frames:
+            if n_frames:
+                raise self.error(first, f"the header declares {n_frames} frames but "
+                                 "the file has none")
+            return FapFile(FapStream.zeros(0, fps=fps), name, version, "standard", ())
+        one_based = frames[0][0] == 1 and max(f[0] for f in frames) == n_frames
+        if one_based:
+            if self.strict:
+                raise self.error(value_lines[0], "frame numbers must start at 0 in strict mode")
+            if dialect == "standard":
+                dialect = "vreng"
+            frames = [(f[0] - 1, *f[1:]) for f in frames]
+        if self.float_values and dialect == "standard":
+            dialect = "xface"
+        return self.assemble(frames, value_lines, fps=fps, n_frames=n_frames, name=name,
+                             version=version, dialect=dialect)
+
+    def frames(self, body: Iterator[_Line], n_frames: int, version: str
+               ) -> tuple[list[_Frame], list[_Line], str]:
+        """Every (mask line, value line) pair parsed, their value lines and the dialect."""
+        frames: list[_Frame] = []
+        value_lines: list[_Line] = []
+        width, dialect = 0, "standard"
         for mask_line in body:
             value_line = next(body, None)
             if value_line is None:
@@ -180,29 +202,7 @@ class _Parser:
             if len(frames) > n_frames + 1:
                 raise self.error(value_line, f"more frames than the {n_frames} the header "
                                  "declares")
-        if not frames:
-            if n_frames:
-                raise self.error(first, f"the header declares {n_frames} frames but "
-                                 "the file has none")
-            return FapFile(FapStream.zeros(0, fps=fps), name, version, "standard", ())
-        frames, dialect = self.renumber(frames, value_lines[0], n_frames, dialect)
-        return self.assemble(frames, value_lines, fps=fps, n_frames=n_frames, name=name,
-                             version=version, dialect=dialect)
-
-    def renumber(
-        self, frames: list[_Frame], first: _Line, n_frames: int, dialect: str
-    ) -> tuple[list[_Frame], str]:
-        """Frames numbered from 0 and the final dialect: frames numbered from 1 are VREng's
-        (refused in strict mode), float values XFace's."""
-        if frames[0][0] == 1 and max(f[0] for f in frames) == n_frames:
-            if self.strict:
-                raise self.error(first, "frame numbers must start at 0 in strict mode")
-            if dialect == "standard":
-                dialect = "vreng"
-            frames = [(f[0] - 1, *f[1:]) for f in frames]
-        if self.float_values and dialect == "standard":
-            dialect = "xface"
-        return frames, dialect
+        return frames, value_lines, dialect
 
     def header(self, line: _Line) -> tuple[str, str, float, int]:
         expected = "expected '<version> <name> <fps> <n_frames>'"
@@ -373,6 +373,15 @@ def _spans(numbers: tuple[int, ...]) -> str:
     return ", ".join(text) + (", ..." if len(spans) > 5 else "")
 
 
+def _check_range(stream: FapStream) -> None:
+    """ParameterError naming the first frame and FAP whose value a ``.fap`` cannot hold."""
+    too_big = np.argwhere(np.abs(stream.values) > VALUE_LIMIT)
+    if too_big.size:
+        frame, column = (int(i) for i in too_big[0])
+        raise ParameterError(f"frame {frame} FAP {column + 1} is {stream.values[frame, column]:g},"
+                             f" beyond the .fap format's range (+-{VALUE_LIMIT})")
+
+
 def write_fap(
     stream: FapStream,
     path: str | os.PathLike[str],
@@ -399,21 +408,25 @@ def write_fap(
 
     Returns the path written.
     """
+    path = Path(path)
+    text = format_fap(stream, dialect=dialect, name=name if name is not None else path.stem)
+    write_text_atomic(path, text)
+    return path
+
+
+def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "facelib") -> str:
+    """The text of a ``.fap`` file holding ``stream`` (see :func:`write_fap` for
+    ``dialect``); ``name`` goes into the header, spaces becoming underscores."""
     stream = check_kind("stream", stream, FapStream)
     if dialect not in DIALECTS:
         raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
-    path = Path(path)
-    label = "_".join((name if name is not None else path.stem).split()) or "facelib"
+    _check_range(stream)
+    label = "_".join(name.split()) or "facelib"
     width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
-    too_big = np.argwhere(np.abs(stream.values) > VALUE_LIMIT)
-    if too_big.size:
-        frame, column = (int(i) for i in too_big[0])
-        raise ParameterError(f"frame {frame} FAP {column + 1} is {stream.values[frame, column]:g},"
-                             f" beyond the .fap format's range (+-{VALUE_LIMIT})")
     values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
         str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
     first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
@@ -425,18 +438,6 @@ def write_fap(
         mask[:, 0] &= stream.viseme is not None
         mask[:, 1] &= stream.expression is not None
     out = [f"2.1 {label} {int(stream.fps)} {stream.n_frames}"]
-    out += _frame_lines(stream, mask, values, first=first, sep=sep)
-    write_text_atomic(path, "\n".join(out) + "\n")
-    return path
-
-
-def _frame_lines(
-    stream: FapStream, mask: np.ndarray, values: list[str], *, first: int, sep: str
-) -> list[str]:
-    """Mask and value lines of every frame: ``mask (n, width) bool`` says which FAPs are
-    written, ``values`` holds each value's text (frame-major, 84 per frame), frames are
-    numbered from ``first`` and tokens joined by ``sep``."""
-    out = []
     for i in range(stream.n_frames):
         out.append(sep.join("1" if m else "0" for m in mask[i]))
         tokens = [str(i + first)]
@@ -448,7 +449,7 @@ def _frame_lines(
             else:
                 tokens.append(values[i * N_FAPS + slot])
         out.append(sep.join(tokens))
-    return out
+    return "\n".join(out) + "\n"
 
 
 def _decimal(value: float) -> str:

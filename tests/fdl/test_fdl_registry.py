@@ -64,3 +64,9 @@ def test_docs_describe_every_function_and_field():
             assert f"`{field}" in doc or f"{field} =" in doc, (spec.name, field)
     for setting in functions.SETTINGS:
         assert f"`{setting}`" in doc, setting
+
+
+def test_fields_come_in_name_order_whatever_the_lua_state():
+    text = 'define_gaze { "n", zeta = 1, alpha = 2, mid = 3, beta = 4 }'
+    orders = {tuple(fdl.loads(text, sandbox=Sandbox()).gaze_defs["n"]) for _ in range(4)}
+    assert orders == {("alpha", "beta", "mid", "zeta")}

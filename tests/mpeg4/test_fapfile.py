@@ -79,7 +79,7 @@ def test_written_standard_file_is_the_plain_profile(tmp_path):
 
 def test_xface_and_extended_dialects_keep_high_level_and_extended(tmp_path):
     values = np.zeros((3, 84), np.float32)
-    values[:, 76] = [1, 2, 3]
+    values[:, 3] = [10, 20, 30]
     viseme = np.array([[1, 2, 10, 0]] * 3)
     expression = np.array([[1, 40, 2, 20, 0, 1]] * 3)
     stream = FapStream(30, values, viseme=viseme, expression=expression)
@@ -151,7 +151,7 @@ def test_failed_write_leaves_the_old_file(tmp_path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr(Path, "write_text", boom)
-    with pytest.raises(FileError, match=r"keep\.fap: cannot write: disk full"):
+    with pytest.raises(FileError, match="disk full"):
         write_fap(FapStream(25, np.zeros((2, 84))), path)
     monkeypatch.undo()
     assert path.read_text() == "old"
