@@ -48,4 +48,4 @@ bench: $(VENV)/.installed
 		PYTHONPATH=. $(BIN)/python benchmarks/$$b.py || exit 1; done
 
 clean:
-	rm -rf $(VENV) $(MINIMAL_VENV) build *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) $(MINIMAL_VENV) build *.egg-info .pytest_cache .ruff_cache .mypy_cache
