@@ -42,11 +42,20 @@ _LAZY = {
     "save_png": "facelib.rendering.frames",
     "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
+    "export_gltf": "facelib.export",
+    "export_html": "facelib.export",
+    "export_arkit": "facelib.export",
+    "import_arkit": "facelib.export",
+    "to_arkit": "facelib.export",
+    "from_arkit": "facelib.export",
+    "setup_face": "facelib.engine.setup",
+    "write_face": "facelib.engine.writer",
 }
 
 
 def __getattr__(name: str) -> Any:
-    """Rendering, the viewer and plotting import OpenGL or matplotlib: load them on use."""
+    """Rendering, the viewer, plotting, the exports and face set-up import OpenGL,
+    matplotlib, pygltflib or trimesh: load them on first use."""
     if name in _LAZY:
         import importlib
 
@@ -74,11 +83,16 @@ __all__ = [
     "SpeechWarning",
     "__version__",
     "animate",
+    "export_arkit",
+    "export_gltf",
+    "export_html",
     "expressions",
     "fap",
     "fdl",
     "feature_point",
+    "from_arkit",
     "gaze",
+    "import_arkit",
     "load_face",
     "mpeg4",
     "plot_curves",
@@ -87,8 +101,11 @@ __all__ = [
     "render_still",
     "run_fdl",
     "save_png",
+    "setup_face",
     "sync",
+    "to_arkit",
     "view",
     "visemes",
+    "write_face",
     "write_fap",
 ]

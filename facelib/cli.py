@@ -113,6 +113,22 @@ def _default_output(story: str, storyboard_output: Path | None, suffix: str) -> 
         return storyboard_output
 
 
+def _face_path(face: str | None) -> Path | None:
+    """``--face``: a face definition JSON, or the folder ``facelib face setup`` wrote."""
+    if face is None:
+        return None
+    path = Path(face)
+    return path / "face.json" if path.is_dir() else path
+
+
+def _face(face: str | None) -> Any:
+    """The Face ``--face`` names, else the default head."""
+    from facelib.engine import default_face, load_face
+
+    path = _face_path(face)
+    return default_face() if path is None else load_face(path)
+
+
 def _source(path: str, seed: int | None, console: Console) -> Any:
     """A storyboard's Animation, or a .fap file's stream."""
     if Path(path).suffix.lower() == ".fap":
@@ -221,7 +237,8 @@ def _add_render_options(command: argparse.ArgumentParser, *, batch: bool) -> Non
                 + ("; with several sources or -j, the folder for STEM.mp4 files" if batch
                    else ""))
     command.add_argument("-o", "--output", required=not batch, help=help_out)
-    command.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    command.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
+                         "folder (default: the storyboard's face, else the bundled head)")
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)
     command.add_argument("--fps", type=float, help="resample to this frame rate")
@@ -249,7 +266,6 @@ def _add_render(commands: Any) -> None:
 
 
 def _render_one(source_path: str, out: str, args: argparse.Namespace, console: Console) -> int:
-    from facelib.engine import load_face
     from facelib.rendering.frames import render
 
     started = time.perf_counter()
@@ -259,7 +275,7 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
         stream = source if isinstance(source, FapStream) else source.faps
         write_fap(stream, args.fap)
         console.status(f"wrote {args.fap} ({stream.n_frames} frames, {stream.duration:.2f} s)")
-    written = render(source, face=load_face(args.face), out=out, width=args.width,
+    written = render(source, face=_face_path(args.face), out=out, width=args.width,
                      height=args.height, audio=args.audio, fps=args.fps,
                      progress=console.progress("rendering"))
     console.status(f"wrote {written} in {time.perf_counter() - started:.1f} s")
@@ -301,7 +317,7 @@ def _render(args: argparse.Namespace, console: Console) -> int:
     results = render_batch(
         args.sources, args.output, jobs=args.jobs, suffix="." + args.format,
         width=args.width, height=args.height, fps=args.fps, seed=args.seed,
-        face=args.face, progress=console.progress("batch", unit="files"),
+        face=_face_path(args.face), progress=console.progress("batch", unit="files"),
     )
     for result in results:
         if result.ok:
@@ -338,10 +354,9 @@ def _add_view(commands: Any) -> None:
 
 
 def _view(args: argparse.Namespace, console: Console) -> int:
-    from facelib.engine import load_face
     from facelib.rendering.viewer import view
 
-    view(_source(args.source, args.seed, console), face=load_face(args.face), loop=args.loop,
+    view(_source(args.source, args.seed, console), face=_face_path(args.face), loop=args.loop,
          sound=not args.mute)
     return EXIT_OK
 
@@ -582,13 +597,185 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     if args.render:
         if video is None:
             raise FacelibError("--render needs a video source (the mirror shows it)")
-        from facelib.engine import load_face
         from facelib.tracking.mirror import render_mirror
 
-        out = render_mirror(video, result.stream, args.render, face=load_face(args.face),
+        out = render_mirror(video, result.stream, args.render, face=_face(args.face),
                             landmarks=landmarks if args.show_landmarks else None)
         console.status(f"wrote {out}")
     return EXIT_OK
+
+
+# -- export and import-arkit -------------------------------------------------------------
+
+
+def _add_export(commands: Any) -> None:
+    export = commands.add_parser(
+        "export", parents=[_COMMON],
+        help="export to glTF (.glb), ARKit curves (.csv/.json) or a web page")
+    export.add_argument("source", help="STORY.fdl or FILE.fap")
+    export.add_argument("-o", "--output",
+                        help="OUT.glb (glTF), or with --arkit OUT.csv (Live Link Face) / OUT.json")
+    export.add_argument("--arkit", action="store_true",
+                        help="write ARKit-52 blendshape curves instead of glTF")
+    export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
+    export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
+    export.add_argument("--seed", type=int)
+    export.set_defaults(run=_export)
+
+    imp = commands.add_parser(
+        "import-arkit", parents=[_COMMON],
+        help="turn an ARKit capture (Live Link Face CSV) into a .fap")
+    imp.add_argument("capture", help="the Live Link Face .csv (or facelib's ARKit .json)")
+    imp.add_argument("-o", "--output", required=True, help="OUT.fap, or - for stdout")
+    imp.add_argument("--fps", type=float,
+                     help="timecode rate of the capture (default: read from the timecodes)")
+    imp.add_argument("--resample", type=float, help="resample to this frame rate (e.g. 25)")
+    imp.add_argument("--dialect", default="standard",
+                     choices=("standard", "xface", "greta", "extended"))
+    imp.set_defaults(run=_import_arkit)
+
+
+def _export(args: argparse.Namespace, console: Console) -> int:
+    import numpy as np
+
+    from facelib import export
+
+    if args.output is None and args.html is None:
+        raise UsageError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
+                         "or both")
+    if args.output is not None:
+        _check_suffix(args.output, (".csv", ".json") if args.arkit else
+                      (".glb", ".csv", ".json"), "export")
+    face = _face(args.face)
+    source = _source(args.source, args.seed, console)
+    if args.output is not None:
+        suffix = Path(args.output).suffix.lower()
+        if args.arkit or suffix in (".csv", ".json"):
+            curves = export.export_arkit(source, args.output, face=face)
+            moving = curves.relative[curves.relative > 0]
+            fit = (f"; fit residual RMS {1000 * float(curves.residual.mean()):.2f} mm, "
+                   f"median relative {float(np.median(moving)):.2f}" if moving.size else "")
+            console.status(f"wrote {args.output} ({curves.n_frames} frames of 52 ARKit "
+                           f"weights{fit})")
+        else:
+            result = export.export_gltf(source, args.output, face=face, audio=args.audio)
+            audio = f", audio {result.audio}" if result.audio else ""
+            console.status(f"wrote {result.path} ({len(result.targets)} morph targets, "
+                           f"{result.n_frames} frames{audio})")
+    if args.html is not None:
+        page = export.export_html(source, args.html, face=face, audio=args.audio)
+        console.status(f"wrote {page.page} (open it in a browser)")
+    return EXIT_OK
+
+
+def _import_arkit(args: argparse.Namespace, console: Console) -> int:
+    from facelib.export import import_arkit
+
+    _check_suffix(args.output, (".fap",), "import-arkit")
+    stream = import_arkit(args.capture, fps=args.fps)
+    if args.resample is not None:
+        stream = stream.resample(args.resample)
+    _emit_text(format_fap(stream, dialect=args.dialect, name=Path(args.capture).stem),
+               args.output, console, f"({stream.n_frames} frames, {stream.duration:.2f} s)")
+    return EXIT_OK
+
+
+# -- face setup --------------------------------------------------------------------------
+
+
+def _add_face(commands: Any) -> None:
+    face = commands.add_parser("face", help="make your own head mesh animatable",
+                               parents=[_COMMON])
+    face_commands = face.add_subparsers(dest="face_command", metavar="ACTION", required=True)
+    setup = face_commands.add_parser(
+        "setup", help="transfer the default face definition onto a head mesh",
+        parents=[_COMMON])
+    setup.add_argument("mesh", help="head mesh: .obj, .ply, .glb/.gltf, .off or .stl")
+    setup.add_argument("--landmarks", help="JSON of feature point -> vertex index or [x, y, z]")
+    setup.add_argument("--auto", action="store_true",
+                       help="find the landmarks automatically (MediaPipe on a front view of "
+                            "the mesh; needs the track and render extras)")
+    setup.add_argument("-o", "--output", required=True, help="folder for face.json + face.npz")
+    setup.add_argument("--unit", choices=("m", "dm", "cm", "mm", "in"),
+                       help="the mesh's length unit (default: guessed from the landmarks)")
+    for axis, default in (("up", "+y"), ("forward", "+z")):
+        setup.add_argument(f"--{axis}", choices=("+x", "-x", "+y", "-y", "+z", "-z"),
+                           help=f"the mesh's {axis} axis (default: guessed from the "
+                                f"landmarks; {default} for --auto)")
+    setup.add_argument("--part", action="append", default=[], metavar="PART=OBJECT",
+                       help="name the file's object for a part (eye_l, eye_r, teeth_upper, "
+                            "teeth_lower, tongue), e.g. --part eye_l=LeftEye")
+    setup.set_defaults(run=_face_setup)
+
+
+def _write_found(found: Any, folder: Path, console: Console) -> None:
+    """The automatic landmarks as an editable JSON and a picture of where they are."""
+    import json
+
+    from facelib.atomic import write_text_atomic
+    from facelib.rendering.video import save_png
+    from facelib.tracking.head_landmarks import draw_landmarks
+
+    write_text_atomic(folder / "landmarks.json",
+                      json.dumps({"landmarks": found.as_json()}, indent=1) + "\n")
+    save_png(draw_landmarks(found), folder / "landmarks.png")
+    console.status(f"found:     {len(found.points)} feature points (see "
+                   f"{folder / 'landmarks.png'}; edit {folder / 'landmarks.json'} and rerun "
+                   "with --landmarks to correct them)")
+
+
+def _face_setup(args: argparse.Namespace, console: Console) -> int:
+    from facelib.engine.headmesh import axes_rotation, load_head_mesh
+    from facelib.engine.setup import set_up_face
+    from facelib.engine.writer import write_face
+
+    if (args.landmarks is None) == (not args.auto):
+        raise UsageError("give either --landmarks L.json or --auto (see docs/own-head.md)")
+    bad = [item for item in args.part if "=" not in item]
+    if bad:
+        raise UsageError(f"--part {bad[0]!r} must be PART=OBJECT, e.g. eye_l=LeftEye")
+    started = time.perf_counter()
+    parts = dict(item.split("=", 1) for item in args.part)
+    mesh = load_head_mesh(args.mesh, parts=parts)
+    landmarks: Any = args.landmarks
+    axes = {"up": args.up, "forward": args.forward}
+    found = None
+    if args.auto:
+        from facelib.tracking.head_landmarks import detect_head_landmarks
+
+        if args.up is not None or args.forward is not None:  # upright before looking
+            mesh = mesh.rotated(axes_rotation(args.up or "+y", args.forward or "+z"))
+            axes = {"up": None, "forward": None}
+        found = detect_head_landmarks(mesh)
+        landmarks = found.as_json()
+    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit, **axes)
+    out = write_face(result.face, Path(args.output) / "face.json", name=Path(args.mesh).stem,
+                     source=f"facelib face setup {Path(args.mesh).name}")
+    if found is not None:
+        _write_found(found, Path(args.output), console)
+    _report_setup(args.mesh, mesh, result, console)
+    console.status(f"wrote {out} in {time.perf_counter() - started:.1f} s")
+    return EXIT_OK
+
+
+def _report_setup(name: str, mesh: Any, result: Any, console: Console) -> None:
+    import numpy as np
+
+    from facelib.mpeg4.tables import FAPU_SCALE
+
+    face = result.face
+    console.status(f"mesh:      {name} ({len(mesh.vertices)} vertices, unit {result.unit})")
+    if not np.allclose(result.rotation, np.eye(3)):
+        console.status("oriented:  turned upright (+y up, looking along +z)")
+    console.status(f"landmarks: {len(result.landmarks)}, off the surface by at most "
+                   f"{result.residual.max() * 1000:.2f} mm")
+    own = [p for p in face.parts if p not in result.carried]
+    console.status(f"parts:     {', '.join(own)} from the mesh"
+                   + (f"; {', '.join(result.carried)} warped into place from the default head"
+                      if result.carried else ""))
+    console.status("FAPU0 (mm): " + "  ".join(f"{k} {v * FAPU_SCALE * 1000:.2f}"
+                                             for k, v in face.fapu.items() if k != "AU"))
 
 
 _COMMON = argparse.ArgumentParser(add_help=False)
@@ -599,7 +786,8 @@ _COMMON.add_argument("-v", "--verbose", action="store_true", default=argparse.SU
 
 _COMMANDS: tuple[Callable[[Any], None], ...] = (
     _add_info, _add_check, _add_run, _add_render, _add_view, _add_plot, _add_align,
-    _add_list, _add_dataset, _add_evaluate, _add_track,
+    _add_list, _add_dataset, _add_evaluate, _add_track, _add_export,
+    _add_face,
 )
 
 

@@ -115,6 +115,7 @@ class Storyboard:
         against its library and adds ``expression_defs[name]`` (FAP overrides) on top.
         Mixes of expressions the storyboard itself defines are resolved at load time.
     output: where the storyboard asks the ``.fap`` to go, or None.
+    face: the face definition JSON the storyboard is played on, or None (the default head).
     """
 
     path: Path | None = None
@@ -127,6 +128,7 @@ class Storyboard:
     gaze_defs: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     output: Path | None = None
     expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    face: Path | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))

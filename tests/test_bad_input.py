@@ -28,6 +28,7 @@ from facelib.errors import (
 from facelib.mpeg4 import FapStream, FapTrack, read_fap, write_fap
 
 JOY = [ExpressionCue("joy", 0, 1000)]
+CARTOON = Path(__file__).parents[1] / "examples" / "heads" / "cartoon_head.obj"
 SAID = SpeechSpec(visemes=(VisemeCue("A", 0, 200),))
 STREAM = FapStream(25, np.zeros((2, 84), np.float32))
 EMPTY = FapTrack.empty(2, fps=25)
@@ -149,6 +150,16 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
      facelib.FaceModelError, "cannot read face definition"),
     ("speech without content", lambda _: visemes.animate(SpeechSpec(), fps=25),
      SpeechError, "neither audio, text nor a viseme script"),
+    ("setup_face mesh format", lambda tmp: facelib.setup_face(tmp / "head.fbx", landmarks={}),
+     facelib.FaceModelError, "unknown mesh format '.fbx'"),
+    ("setup_face landmarks missing", lambda tmp: facelib.setup_face(
+        CARTOON, landmarks=tmp / "none.json"), facelib.FaceModelError, "cannot read landmarks"),
+    ("setup_face 3 landmarks", lambda _: facelib.setup_face(
+        CARTOON, landmarks={"9.3": 1, "2.1": 2, "4.1": 3}),
+     facelib.FaceModelError, "a 3-D warp needs at least 4"),
+    ("setup_face unit", lambda _: facelib.setup_face(
+        CARTOON, landmarks=CARTOON.with_name("cartoon_landmarks.json"), unit="km"),
+     ParameterError, "unit 'km' is not one of"),
 ]
 
 

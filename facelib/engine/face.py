@@ -13,7 +13,8 @@ Deformation of one frame ``f`` (84 FAP values):
    ``f_3 * MNS`` plus the thrust (FAP 14) and shift (FAP 15) translations;
 5. the head rotates about its pivot (FAP 48-50), fading to nothing over the neck.
 
-FAPs 1-2 (high-level visemes and expressions, expanded by the generators), 29-30 (pupil
+FAPs 1-2 (high-level visemes and expressions) are decoded into low-level FAPs by ``deform``
+(:mod:`facelib.mpeg4.highlevel`); 29-30 (pupil
 dilation) and 47 (tongue roll) do not move this mesh.
 """
 
@@ -31,6 +32,7 @@ from facelib.engine import rigid
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
 from facelib.errors import FaceModelError, ParameterError
+from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 
@@ -178,6 +180,8 @@ class Face:
         radians (eq. 4.1-4.5).
     regions: the influence regions.
     pivots: ``eye_l``, ``eye_r``, ``head``, ``jaw`` -> (3,) float64 positions.
+    neck: ``(point (3,), unit normal (3,) into the head, blend distance)`` of the plane
+        where head rotations fade out.
     operator: scipy CSR array (84, 3V) float32: vertex displacements (flattened ``(V, 3)``)
         per FAP unit, for every translational FAP that deforms linearly.
     """
@@ -190,6 +194,7 @@ class Face:
     fapu: Mapping[str, float]
     regions: tuple[Region, ...]
     pivots: Mapping[str, np.ndarray]
+    neck: tuple[np.ndarray, np.ndarray, float]
     operator: sp.csr_array = field(repr=False)
     _columns: np.ndarray = field(repr=False)
     _dense: np.ndarray = field(repr=False)
@@ -241,6 +246,8 @@ class Face:
             fapu=fapu,
             regions=tuple(regions),
             pivots=MappingProxyType(pivot_map),
+            neck=(_readonly(neck[0], np.float64), _readonly(neck[1], np.float64),
+                  float(neck[2])),
             operator=operator,
             _columns=columns,
             _dense=dense,
@@ -259,9 +266,14 @@ class Face:
         return int(self.vertices.shape[0])
 
     def deform(self, stream: FapStream) -> np.ndarray:
-        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``."""
+        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``.
+
+        High-level FAPs 1 and 2 (viseme and expression selects and blends) are decoded
+        first (:func:`facelib.mpeg4.highlevel.apply_high_level`), as an MPEG-4 player does.
+        """
         if not isinstance(stream, FapStream):
             raise ParameterError(f"deform() takes a FapStream, not {type(stream).__name__}")
+        stream = apply_high_level(stream)  # FAP 1/2 from other tools' files
         return self._deform(np.asarray(stream.values, dtype=np.float32))
 
     def deform_frame(self, values: np.ndarray) -> np.ndarray:

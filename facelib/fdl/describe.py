@@ -20,7 +20,8 @@ def describe(sb: Storyboard) -> str:
     with its time span (seconds) and origin ``file:line``."""
     out = [
         f"storyboard: {sb.path or '<string>'}",
-        f"fps: {sb.fps:g}  seed: {sb.seed}  output: {sb.output or 'none'}",
+        f"fps: {sb.fps:g}  seed: {sb.seed}  output: {sb.output or 'none'}"
+        + (f"  face: {sb.face}" if sb.face is not None else ""),
     ]
     s = sb.speech
     if s is not None:

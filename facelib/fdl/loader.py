@@ -3,7 +3,8 @@
 One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts, or the
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
-``fps`` (default 25), ``seed`` (default 0) and ``output`` set the storyboard options; every
+``fps`` (default 25), ``seed`` (default 0), ``output`` and ``face`` (a face definition
+JSON, e.g. one made by ``facelib face setup``) set the storyboard options; every
 name is declared in :mod:`facelib.fdl.functions`. Each syntax converts to cues in its own
 module (:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs
 the script, reads the settings and merges the two.
@@ -195,6 +196,9 @@ def _build(
     output = _output(chunk, fdl, fdl_line, ctx)
     if output is not None:
         _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
+    face_value = _global(chunk, "face")
+    face = (None if face_value is None else resolve_inside(
+        base_dir, face_value, what="face", path=name, line=_line(text, "face")))
     return Storyboard(
         path=file,
         fps=fps,
@@ -207,6 +211,7 @@ def _build(
         gaze_defs=parts.gaze_defs,
         output=output,
         expression_mixes=parts.expression_mixes,
+        face=face,
     )
 
 

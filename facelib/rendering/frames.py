@@ -47,13 +47,18 @@ def stream_of(source: FapStream | HasFaps) -> tuple[FapStream, Path | None, floa
     )
 
 
-def face_or_default(face: Deformable | None) -> Deformable:
-    """``face``, or facelib's default head when it is None."""
-    if face is not None:
-        return face
-    from facelib.engine import default_face
+def face_or_default(face: Deformable | str | os.PathLike[str] | None,
+                    source: object = None) -> Deformable:
+    """``face``; a face definition JSON path loaded; None: the face the source's storyboard
+    names (``face = "..."``), else facelib's default head."""
+    from facelib.engine import default_face, load_face
 
-    return default_face()
+    if face is None:
+        storyboard = getattr(source, "storyboard", None)
+        face = getattr(storyboard, "face", None)
+    if isinstance(face, (str, os.PathLike)):
+        return load_face(Path(face))
+    return default_face() if face is None else face
 
 
 def iter_frames(
@@ -78,7 +83,7 @@ def iter_frames(
 def render(
     source: FapStream | HasFaps,
     *,
-    face: Deformable | None = None,
+    face: Deformable | str | os.PathLike[str] | None = None,
     out: str | os.PathLike[str] | None = None,
     width: int = 640,
     height: int = 480,
@@ -95,7 +100,8 @@ def render(
     source: a :class:`FapStream`, or an animation with ``.faps`` (and optional ``.audio``,
         ``.audio_offset``).
     face: the face to deform (``Face``-like: ``vertices``, ``triangles``, ``vertex_colors``,
-        ``parts``, ``deform``); None loads the default head.
+        ``parts``, ``deform``) or a face definition JSON path; None takes the face the
+        storyboard names (``face = "..."``), else the default head.
     out: None returns the frames; a path writes them by suffix: ``.mp4`` (H.264, with the
         audio), ``.gif``, or a folder (no suffix) of ``frame_NNNNNN.png``; ``.png`` writes a
         single-frame source as one still.
@@ -117,7 +123,7 @@ def render(
         stream = stream.resample(fps)
     audio = source_audio if audio is None else Path(audio)
     offset = source_offset if audio_offset is None else float(audio_offset)
-    face = face_or_default(face)
+    face = face_or_default(face, source)
     if out is not None and Path(out).suffix.lower() == ".png":
         return _one_png(face, stream, out, width=width, height=height, background=background)
     if out is None and audio is not None and source_audio is None:

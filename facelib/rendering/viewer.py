@@ -95,7 +95,7 @@ def _sound(audio: Path | None, offset: float) -> Any:
 def view(
     source: FapStream | HasFaps,
     *,
-    face: Deformable | None = None,
+    face: Deformable | str | os.PathLike[str] | None = None,
     width: int = 800,
     height: int = 600,
     loop: bool = False,
@@ -124,7 +124,7 @@ def view(
             f"{os.environ['PYOPENGL_PLATFORM']!r}); open the viewer in a fresh process"
         )
     stream, audio, offset = stream_of(source)
-    face = face_or_default(face)
+    face = face_or_default(face, source)
     pr = import_pyrender(offscreen=False)
     scene = FaceRenderer(face, width=width, height=height, mesh_update="swap", offscreen=False)
     state = Playback(stream.fps, stream.n_frames)

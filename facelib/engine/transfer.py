@@ -1,0 +1,266 @@
+"""Transfer of a face definition onto another head (third seed, sections 4.7.1-4.7.3).
+
+1. the thin-plate spline ``T`` of the landmarks (eq. 4.1-4.5) warps the source;
+2. every warped source vertex moves to its closest point on the same part of the target
+   (eq. 4.7, with a normal check): the *guide model*;
+3. each target vertex takes the source attributes interpolated (barycentric) at its closest
+   point on the guide: region membership (an indicator, kept at >= 0.5), per-vertex weights
+   (jaw, eyelids) and colours;
+4. point attributes (feature points, RBF anchors) go to the target vertex nearest to their
+   guide position; pivots and the neck plane go through ``T`` (normals by ``J^-T``, lengths
+   by ``|det J|^(1/3)``);
+5. parts the target lacks (eyeballs, teeth, tongue) are carried: eyeballs by a similarity
+   about ``T(centre)`` so they stay spheres, teeth and tongue through ``T``.
+
+FAPU come out of the new mesh when the :class:`~facelib.engine.face.Face` is built, which
+rescales every FAP stream to the new proportions (the seed's animation transfer).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from facelib.engine.face import PART_NAMES, Face, Region
+from facelib.engine.headmesh import HeadMesh
+from facelib.engine.surface import Surface, SurfacePoints, closest_points, surface, vertex_normals
+from facelib.engine.tps import ThinPlateSpline
+
+__all__ = ["transfer_face"]
+
+# a target eyeball centred this far (x its radius) from the warped source eye centre
+# rotates about its own centre (sphere fit) instead
+_EYE_CENTRE_TOLERANCE = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class _Dense:
+    """A part of the target matched to the same part of the source.
+
+    offset: first global vertex id of the part in the output mesh.
+    guide: (Vs, 3) float64 guide model (warped, projected source vertices of the part).
+    guide_surface: the guide as a surface (source triangles, local ids).
+    match: each target vertex's closest point on the guide.
+    tree: cKDTree over the target part's vertices.
+    """
+
+    offset: int
+    guide: np.ndarray
+    guide_surface: Surface
+    match: SurfacePoints
+    tree: cKDTree
+
+
+@dataclass(frozen=True, eq=False)
+class _Carried:
+    """A source part copied into the output (warped): ``offset`` of its first vertex."""
+
+    offset: int
+
+
+def _local(ids: np.ndarray, n: int) -> np.ndarray:
+    out = np.full(n, -1, np.int64)
+    out[ids] = np.arange(ids.size)
+    return out
+
+
+def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
+                  landmark_vertices: Mapping[str, tuple[str, int]], *,
+                  min_cos: float = 0.5) -> Face:
+    """A new Face on ``target`` (metres, face frame) from ``source`` through ``tps``.
+
+    landmark_vertices: feature point -> (part, index within the target's part) for
+        landmarks given as vertices: they keep exactly that vertex when the part is the
+        feature point's part on the source.
+    """
+    warped = tps(source.vertices.astype(np.float64))
+    blocks: dict[str, _Dense | _Carried] = {}
+    positions, triangles, colours = [], [], []
+    offset = 0
+    for name in PART_NAMES:
+        src = source.parts[name]
+        src_tris = _local(src.vertex_ids, source.n_vertices)[src.triangles]
+        if name in target.parts and target.parts[name].size:
+            ids = target.parts[name]
+            pos = target.vertices[ids]
+            tris = target.part_triangles(name)
+            block = _dense(warped[src.vertex_ids], src_tris, pos, tris, offset=offset,
+                           min_cos=min_cos)
+            col = (target.colors[ids] if target.colors is not None else
+                   block.match.interpolate(block.guide_surface,
+                                           source.vertex_colors[src.vertex_ids]))
+            blocks[name] = block
+        else:
+            pos, tris = _carry(source, name, tps, warped), src_tris
+            col = source.vertex_colors[src.vertex_ids]
+            blocks[name] = _Carried(offset)
+        positions.append(pos)
+        triangles.append(tris + offset)
+        colours.append(col)
+        offset += len(pos)
+    part_of = np.empty(source.n_vertices, dtype=object)
+    local_of = np.zeros(source.n_vertices, np.int64)
+    for name in PART_NAMES:
+        ids = source.parts[name].vertex_ids
+        part_of[ids] = name
+        local_of[ids] = np.arange(ids.size)
+    mapper = _Mapper(blocks, part_of, local_of)
+    points = mapper.feature_points(source.feature_points, landmark_vertices)
+    regions = tuple(mapper.region(r, points) for r in source.regions)
+    return Face.build(
+        vertices=np.concatenate(positions), triangles=np.concatenate(triangles),
+        vertex_colors=np.clip(np.concatenate(colours), 0, 1),
+        parts=_part_ranges(positions), feature_points=points, regions=regions,
+        pivots=_pivots(source, tps, blocks, positions), neck=_neck(source, tps))
+
+
+def _dense(warped: np.ndarray, src_tris: np.ndarray, pos: np.ndarray, tris: np.ndarray, *,
+           offset: int, min_cos: float) -> _Dense:
+    target_surface = surface(pos, tris)
+    projected = closest_points(target_surface, warped,
+                               normals=vertex_normals(warped, src_tris), min_cos=min_cos)
+    guide = projected.points
+    guide_surface = surface(guide, src_tris)
+    match = closest_points(guide_surface, pos, normals=vertex_normals(pos, tris),
+                           min_cos=min_cos)
+    return _Dense(offset, guide, guide_surface, match, cKDTree(pos))
+
+
+def _carry(source: Face, name: str, tps: ThinPlateSpline, warped: np.ndarray) -> np.ndarray:
+    ids = source.parts[name].vertex_ids
+    if name in ("eye_l", "eye_r"):
+        centre = source.pivots[name]
+        scale = abs(float(np.linalg.det(tps.jacobian(centre)[0]))) ** (1 / 3)
+        return tps(centre)[0] + scale * (source.vertices[ids].astype(np.float64) - centre)
+    return warped[ids]
+
+
+def _part_ranges(positions: list[np.ndarray]) -> dict[str, np.ndarray]:
+    out, start = {}, 0
+    for name, pos in zip(PART_NAMES, positions, strict=True):
+        out[name] = np.arange(start, start + len(pos))
+        start += len(pos)
+    return out
+
+
+def _pivots(source: Face, tps: ThinPlateSpline, blocks: Mapping[str, object],
+            positions: list[np.ndarray]) -> dict[str, np.ndarray]:
+    out = {name: tps(p)[0] for name, p in source.pivots.items()}
+    for k, name in enumerate(PART_NAMES[1:3], start=1):
+        if isinstance(blocks[name], _Dense):  # the target's own eyeball
+            centre, radius = _sphere(positions[k])
+            if np.linalg.norm(out[name] - centre) > _EYE_CENTRE_TOLERANCE * radius:
+                out[name] = centre
+    return out
+
+
+def _sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares sphere through ``points (n, 3)``: centre (3,) and radius."""
+    a = np.c_[2 * points, np.ones(len(points))]
+    b = np.sum(points * points, axis=1)
+    sol = np.linalg.lstsq(a, b, rcond=None)[0]
+    centre = sol[:3]
+    return centre, float(np.sqrt(max(sol[3] + centre @ centre, 0.0)))
+
+
+def _neck(source: Face, tps: ThinPlateSpline) -> tuple[np.ndarray, np.ndarray, float]:
+    point, normal, blend = source.neck
+    jac = tps.jacobian(point)[0]
+    moved = np.linalg.solve(jac.T, normal)
+    scale = abs(float(np.linalg.det(jac))) ** (1 / 3)
+    return tps(point)[0], moved / np.linalg.norm(moved), blend * scale
+
+
+class _Mapper:
+    """Maps source vertex sets and fields onto the output mesh, part by part."""
+
+    def __init__(self, blocks: Mapping[str, object], part_of: np.ndarray,
+                 local_of: np.ndarray):
+        self.blocks = blocks
+        self.part_of = part_of
+        self.local_of = local_of
+
+    def _by_part(self, ids: np.ndarray) -> dict[str, np.ndarray]:
+        parts = self.part_of[ids]
+        return {name: ids[parts == name] for name in PART_NAMES if (parts == name).any()}
+
+    def nearest(self, ids: np.ndarray) -> np.ndarray:
+        """Output vertex nearest to each source vertex's guide position (or its copy)."""
+        out = np.zeros(ids.size, np.int64)
+        parts = self.part_of[ids]
+        for name, sub in self._by_part(ids).items():
+            block = self.blocks[name]
+            local = self.local_of[sub]
+            if isinstance(block, _Dense):
+                _, hit = block.tree.query(block.guide[local])
+                out[parts == name] = block.offset + np.asarray(hit)
+            else:
+                assert isinstance(block, _Carried)
+                out[parts == name] = block.offset + local
+        return out
+
+    def feature_points(self, points: Mapping[str, int],
+                       given: Mapping[str, tuple[str, int]]) -> dict[str, int]:
+        """Each feature point on its own output vertex (given landmark vertices first)."""
+        out: dict[str, int] = {}
+        taken: set[int] = set()
+        for fp_id, (part, vertex) in given.items():
+            block = self.blocks[part]
+            if part == self.part_of[points[fp_id]] and isinstance(block, _Dense):
+                out[fp_id] = block.offset + vertex
+                taken.add(out[fp_id])
+        for fp_id, v in points.items():
+            if fp_id in out:
+                continue
+            block = self.blocks[str(self.part_of[v])]
+            if isinstance(block, _Carried):
+                out[fp_id] = block.offset + int(self.local_of[v])
+                continue
+            assert isinstance(block, _Dense)
+            k = min(8, block.tree.n)
+            _, hits = block.tree.query(block.guide[self.local_of[v]], k=k)
+            free = [int(h) + block.offset for h in np.atleast_1d(hits)
+                    if int(h) + block.offset not in taken]
+            out[fp_id] = free[0] if free else int(np.atleast_1d(hits)[0]) + block.offset
+            taken.add(out[fp_id])
+        return out
+
+    def region(self, region: Region, points: Mapping[str, int]) -> Region:
+        members, weights = [], []
+        for name, sub in self._by_part(region.vertices.astype(np.int64)).items():
+            block = self.blocks[name]
+            if isinstance(block, _Carried):
+                members.append(block.offset + self.local_of[sub])
+                if region.weights.size:
+                    weights.append(region.weights[np.isin(region.vertices, sub)])
+                continue
+            assert isinstance(block, _Dense)
+            indicator = np.zeros(block.guide.shape[0])
+            indicator[self.local_of[sub]] = 1.0
+            inside = block.match.interpolate(block.guide_surface, indicator)
+            keep = np.flatnonzero(inside >= 0.5)
+            if not keep.size:  # a region too small for this mesh: its nearest vertices
+                keep = np.unique(self.nearest(sub)) - block.offset
+            members.append(block.offset + keep)
+            if region.weights.size:
+                field = np.zeros(block.guide.shape[0])
+                field[self.local_of[sub]] = region.weights[np.isin(region.vertices, sub)]
+                value = block.match.interpolate(block.guide_surface, field)[keep]
+                weights.append(np.clip(value / np.maximum(inside[keep], 0.5), 0.0, 1.0))
+        ids = np.concatenate(members)
+        order = np.argsort(ids, kind="stable")
+        ids, first = np.unique(ids[order], return_index=True)
+        w = np.concatenate(weights)[order][first] if weights else np.zeros(0)
+        anchors = np.zeros(0, np.int64)
+        if region.anchors.size:
+            controls = [points[f] for f in region.feature_points]
+            anchors = np.setdiff1d(self.nearest(region.anchors.astype(np.int64)),
+                                   np.concatenate([ids, controls]))
+        return Region(name=region.name, deformer=region.deformer,
+                      feature_points=region.feature_points, vertices=ids.astype(np.int32),
+                      anchors=anchors.astype(np.int32), weights=w.astype(np.float32),
+                      pivot=region.pivot, params=region.params, group=region.group,
+                      custom=region.custom)

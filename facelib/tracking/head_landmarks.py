@@ -1,0 +1,188 @@
+"""Automatic landmarks for face set-up: find the feature points of a head mesh by looking.
+
+The mesh is rendered from the front with facelib's renderer, MediaPipe's face mesh finds
+its 478 landmarks in the picture, the packaged table maps them to MPEG-4 feature points
+(:mod:`facelib.tracking.layouts`), and a ray from the camera through each feature point's
+pixel is cast back onto the mesh; the first hit is the landmark. The mesh must look along
++z with +y up (any unit).
+
+Feature points whose MediaPipe position follows another convention than the default head's
+(mid and outer brows 4.3-4.6 on the brow's upper edge, nostrils 9.1/9.2, 9.15) and the
+inner lip points but 2.2 are left out (on closed lips they all fall on the one mouth line;
+2.2 there pins the line where the lips part), as are the pupils when the mesh has no
+eyeballs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import cast
+
+import numpy as np
+
+from facelib.engine.headmesh import HeadMesh
+from facelib.errors import FaceModelError, TrackingError
+
+__all__ = ["AUTO_EXCLUDED", "HeadLandmarks", "detect_head_landmarks", "draw_landmarks"]
+
+AUTO_EXCLUDED = ("4.3", "4.4", "4.5", "4.6", "9.1", "9.2", "9.15",
+                 "2.3", "2.4", "2.5", "2.6", "2.7", "2.8", "2.9")
+"""Feature points the automatic landmarks leave out (see the module docstring)."""
+_DOT = (40, 220, 80)
+_HOLE_DEPTH = 0.08  # a hit this far (x the head's size) behind the median hit went through
+_SKIN = (0.87, 0.68, 0.57)  # the default head's skin colour (sRGB), for uncoloured meshes
+
+
+@dataclass(frozen=True, eq=False)
+class HeadLandmarks:
+    """What the automatic landmark search found.
+
+    points: feature point id -> (3,) float64 position on the mesh (its unit).
+    pixels: feature point id -> (2,) float64 (column, row) where MediaPipe put it.
+    image: (H, W, 3) uint8 the front view that was searched.
+    """
+
+    points: dict[str, np.ndarray]
+    pixels: dict[str, np.ndarray]
+    image: np.ndarray
+
+    def as_json(self) -> dict[str, list[float]]:
+        """``{fp: [x, y, z]}`` for a landmark file."""
+        return {k: [float(c) for c in v] for k, v in self.points.items()}
+
+
+@dataclass(frozen=True, eq=False)
+class _View:
+    """The mesh as the renderer wants it (no parts: one piece)."""
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    vertex_colors: np.ndarray
+    parts: None = None
+
+
+def _render(mesh: HeadMesh, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Front view ``(size, size, 3) uint8``, the camera pose (4, 4) and projection (4, 4)."""
+    from facelib.rendering.protocols import Deformable
+    from facelib.rendering.scene import FaceRenderer
+
+    colours = (np.tile(_SKIN, (len(mesh.vertices), 1)) if mesh.colors is None
+               else mesh.colors)
+    view = _View(mesh.vertices.astype(np.float32), mesh.triangles,
+                 np.asarray(colours, np.float32))
+    skin = mesh.vertices[mesh.parts["skin"]]
+    # the renderer reads only vertices, triangles, vertex_colors and parts of a still face
+    still = cast("Deformable", view)
+    with FaceRenderer(still, width=size, height=size, framing=skin) as renderer:
+        image = renderer.frame(view.vertices)
+        camera = renderer.scene.main_camera_node.camera
+        projection = camera.get_projection_matrix(size, size)
+        return image, np.asarray(renderer.camera_pose, np.float64), projection
+
+
+def _rays(pixels: np.ndarray, pose: np.ndarray, projection: np.ndarray, size: int
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Origins and unit directions ``(n, 3)`` of camera rays through ``pixels (n, 2)``."""
+    ndc = np.c_[2 * pixels[:, 0] / size - 1, 1 - 2 * pixels[:, 1] / size]
+    inverse = np.linalg.inv(projection @ np.linalg.inv(pose))
+    ends = []
+    for depth in (-1.0, 1.0):
+        homo = np.c_[ndc, np.full(len(ndc), depth), np.ones(len(ndc))] @ inverse.T
+        ends.append(homo[:, :3] / homo[:, 3:4])
+    direction = ends[1] - ends[0]
+    return ends[0], direction / np.linalg.norm(direction, axis=1, keepdims=True)
+
+
+def _hits(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """First hit of each ray on the mesh ``(n, 3)``; NaN where a ray misses.
+
+    Moller-Trumbore against every triangle (a few dozen rays: ``n x F`` tests).
+    """
+    corners = mesh.vertices[mesh.triangles]  # (F, 3, 3)
+    a = corners[:, 0]
+    e1, e2 = corners[:, 1] - a, corners[:, 2] - a
+    out = np.full((len(origins), 3), np.nan)
+    for k, (origin, direction) in enumerate(zip(origins, directions, strict=True)):
+        p = np.cross(direction, e2)
+        det = np.einsum("fc,fc->f", e1, p)
+        ok = np.abs(det) > 1e-18
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        t_vec = origin - a
+        u = np.einsum("fc,fc->f", t_vec, p) * inv
+        q = np.cross(t_vec, e1)
+        v = (q @ direction) * inv
+        dist = np.einsum("fc,fc->f", e2, q) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (dist > 0)
+        if hit.any():
+            out[k] = origin + direction * dist[hit].min()
+    return _through_holes(mesh, origins, directions, out)
+
+
+def _through_holes(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray,
+                   hits: np.ndarray) -> np.ndarray:
+    """Rays that slip through an opening (eye sockets without eyeballs, under the chin)
+    hit far behind the face: take the vertex nearest to such a ray instead, among those no
+    deeper than the face's front."""
+    depth = np.einsum("nc,nc->n", hits - origins, directions)
+    front = float(np.nanmedian(depth))
+    extent = float(np.ptp(mesh.vertices[mesh.parts["skin"]], axis=0).max())
+    out = hits.copy()
+    for k in np.flatnonzero(~(depth <= front + _HOLE_DEPTH * extent)):
+        rel = mesh.vertices - origins[k]
+        along = rel @ directions[k]
+        off = np.linalg.norm(rel - along[:, None] * directions[k], axis=1)
+        off[along > front + _HOLE_DEPTH * extent] = np.inf
+        out[k] = mesh.vertices[int(np.argmin(off))]
+    return out
+
+
+def detect_head_landmarks(mesh: HeadMesh, *, size: int = 640,
+                          feature_points: tuple[str, ...] | None = None) -> HeadLandmarks:
+    """Find feature points on an upright, front-facing head mesh (see the module docstring).
+
+    feature_points: the ids wanted (default: the default head's feature points); those in
+        ``AUTO_EXCLUDED`` and the ones the MediaPipe table does not map are left out.
+
+    Raises FaceModelError when MediaPipe finds no face in the front view (the mesh is not
+    upright and facing +z, or not a face) or too few rays hit the mesh.
+    """
+    from facelib.tracking.layouts import landmark_layout
+    from facelib.tracking.mediapipe import detect_landmarks
+
+    image, pose, projection = _render(mesh, size)
+    try:
+        found = detect_landmarks(image)
+    except TrackingError as exc:
+        raise FaceModelError(
+            f"{mesh.name}: no face was found in the front view of the mesh ({exc.message}); "
+            "turn the mesh upright (+y up) facing +z, or give landmarks by hand") from exc
+    layout = landmark_layout("mediapipe")
+    pixels = layout.feature_point_positions(found.points[None, :, :2])[0]
+    wanted = [fp for fp in layout.feature_points if fp not in AUTO_EXCLUDED
+              and (fp not in ("3.5", "3.6") or "eye_l" in mesh.parts)]
+    if feature_points is None:
+        from facelib.engine import default_face
+
+        feature_points = tuple(default_face().feature_points)
+    wanted = [fp for fp in wanted if fp in feature_points]
+    rows = np.array([layout.index(fp) for fp in wanted])
+    origins, directions = _rays(pixels[rows], pose, projection, size)
+    hit = _hits(mesh, origins, directions)
+    ok = np.isfinite(hit).all(axis=1)
+    if ok.sum() < 4:
+        raise FaceModelError(f"{mesh.name}: only {int(ok.sum())} feature points found on the "
+                             "mesh; give landmarks by hand")
+    return HeadLandmarks(
+        points={fp: hit[k] for k, fp in enumerate(wanted) if ok[k]},
+        pixels={fp: pixels[rows[k]] for k, fp in enumerate(wanted) if ok[k]},
+        image=image)
+
+
+def draw_landmarks(found: HeadLandmarks) -> np.ndarray:
+    """The searched front view with the found feature points drawn: ``(H, W, 3) uint8``."""
+    image = found.image.copy()
+    height, width = image.shape[:2]
+    for x, y in found.pixels.values():
+        cx, cy = round(float(x)), round(float(y))
+        image[max(cy - 2, 0):min(cy + 3, height), max(cx - 2, 0):min(cx + 3, width)] = _DOT
+    return image

@@ -1,0 +1,72 @@
+"""Automatic landmarks for face set-up: MediaPipe on a front view of a head mesh, rays cast
+back onto the mesh, checked against the test heads' true feature points."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from facelib.engine.headmesh import head_mesh, load_head_mesh
+from facelib.engine.setup import read_landmarks, set_up_face
+from facelib.errors import FaceModelError
+
+pytest.importorskip("mediapipe")
+if importlib.util.find_spec("pyrender") is None:
+    pytest.skip("needs the render extra", allow_module_level=True)
+pytestmark = pytest.mark.render
+
+from facelib.tracking.head_landmarks import (  # noqa: E402
+    AUTO_EXCLUDED,
+    detect_head_landmarks,
+    draw_landmarks,
+)
+
+HEADS = Path(__file__).resolve().parents[2] / "examples" / "heads"
+
+
+def _errors(name: str, suffix: str) -> tuple[np.ndarray, object]:
+    mesh = load_head_mesh(HEADS / f"{name}_head.{suffix}")
+    truth = read_landmarks(HEADS / f"{name}_landmarks.json")
+    found = detect_head_landmarks(mesh)
+    assert not set(found.points) & set(AUTO_EXCLUDED[1:])
+    err = np.array([np.linalg.norm(found.points[k] - truth[k]) for k in found.points
+                    if k in truth])
+    return err, found
+
+
+def test_soma_head_landmarks_within_3_mm() -> None:
+    err, found = _errors("soma", "ply")
+    assert len(err) >= 15
+    assert np.median(err) <= 3e-3
+    picture = draw_landmarks(found)  # type: ignore[arg-type]
+    assert picture.shape == found.image.shape  # type: ignore[attr-defined]
+    assert (picture != found.image).any()  # type: ignore[attr-defined]
+
+
+def test_cartoon_head_landmarks() -> None:
+    # MediaPipe's face model does not follow the cartoon's long chin: 2.1 and 2.10 land
+    # 31-38 mm above the true chin, and the wide mouth's corners about 5 mm inside; the
+    # median misses the 3 mm goal (measured 4.2 mm)
+    err, _ = _errors("cartoon", "obj")
+    assert np.median(err) <= 4.5e-3
+    assert np.sort(err)[-3] <= 7e-3
+
+
+def test_auto_landmarks_set_up_a_face() -> None:
+    mesh = load_head_mesh(HEADS / "soma_head.ply")
+    found = detect_head_landmarks(mesh)
+    face = set_up_face(mesh, landmarks=found.as_json()).face
+    fp = face.feature_points
+    # the lips part where they should: the inner upper lip above the inner lower lip
+    assert face.vertices[fp["2.2"], 1] > face.vertices[fp["2.3"], 1]
+    assert 8e-3 < face.fapu["MNS"] * 1024 < 16e-3
+
+
+def test_no_face_in_the_front_view() -> None:
+    sphere = __import__("trimesh").creation.icosphere(subdivisions=3, radius=0.1)
+    mesh = head_mesh(np.asarray(sphere.vertices), np.asarray(sphere.faces), name="ball")
+    with pytest.raises(FaceModelError, match="ball: no face was found"):
+        detect_head_landmarks(mesh)
