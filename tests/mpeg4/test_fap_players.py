@@ -14,7 +14,7 @@ from facelib.mpeg4 import fap
 from facelib.mpeg4.highlevel import apply_high_level, expression_table, viseme_table
 from facelib.mpeg4.visemes import viseme_id
 
-DATA = Path(__file__).parent / "data" / "fap"
+DATA = Path(__file__).parents[1] / "data" / "fap"
 
 
 def _stream_with_extended() -> FapStream:
