@@ -397,13 +397,16 @@ def _add_align(commands: Any) -> None:
     align.add_argument("--format", choices=("json", "tsv", "sb"), default="json",
                        help="the format written to stdout by -o - (default json)")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
+    align.add_argument("--lang", default="en",
+                       help="language of the speech (en: pocketsphinx; others: DTW against "
+                            "espeak-ng, which needs --text)")
     align.set_defaults(run=_align)
 
 
 def _align(args: argparse.Namespace, console: Console) -> int:
     import json
 
-    from facelib.visemes import align
+    from facelib.visemes import align, align_dtw
     from facelib.visemes.scripts import (
         timeline_to_json,
         timeline_to_sentence,
@@ -419,7 +422,12 @@ def _align(args: argparse.Namespace, console: Console) -> int:
             text = Path(args.text_file).read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise FileError(f"cannot read the transcript: {exc}", path=args.text_file) from exc
-    timeline = align(args.audio, text)
+    if args.lang.lower().startswith("en"):
+        timeline = align(args.audio, text)
+    elif text is None:
+        raise UsageError(f"aligning speech in {args.lang!r} needs its transcript (--text)")
+    else:
+        timeline = align_dtw(args.audio, text, lang=args.lang)
     formatted = {
         "json": lambda: json.dumps(timeline_to_json(timeline), indent=1) + "\n",
         "tsv": lambda: timeline_to_tsv(timeline),
@@ -439,13 +447,14 @@ def _add_list(commands: Any) -> None:
         "list", parents=[_COMMON],
         help="list the names a storyboard may use: " + ", ".join(KINDS))
     listing.add_argument("kind", choices=KINDS)
+    listing.add_argument("--lang", help="voices: only those of this language (e.g. de)")
     listing.set_defaults(run=_list)
 
 
 def _list(args: argparse.Namespace, console: Console) -> int:
     from facelib.catalog import catalog
 
-    entries = catalog(args.kind)
+    entries = catalog(args.kind, lang=args.lang)
     width = max((len(e.name) for e in entries), default=0)
     for entry in entries:
         extra = f"  [{entry.image}]" if entry.image else ""

@@ -36,6 +36,7 @@ __all__ = [
     "read_show",
 ]
 
+_SAY_RANGES = {"rate": (0.5, 2.5), "pitch": (0.0, 100.0)}
 _MAX_FAP_VALUE = 100_000.0
 
 
@@ -63,6 +64,10 @@ class DraftSpeech:
     transcript: str | None = None
     audio: str | None = None
     visemes: tuple[tuple[str, int, int | None], ...] | None = None
+    lang: str | None = None
+    voice: str | None = None
+    rate: float = 1.0
+    pitch: float = 50.0
 
 
 @dataclass(slots=True)
@@ -223,7 +228,8 @@ def read_say(
             path=ctx.path,
             line=line,
         )
-    strings = {key: _string(f, key, "say", ctx, line) for key in ("text", "transcript", "audio")}
+    strings = {key: _string(f, key, "say", ctx, line)
+               for key in ("text", "transcript", "audio", "lang", "voice")}
     text = first if isinstance(first, str) else strings["text"]
     if t.items and "text" in f:
         raise FdlError(
@@ -233,6 +239,8 @@ def read_say(
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
+    numbers = {key: _ranged(f, key, low, high, ctx=ctx, line=line)
+               for key, (low, high) in _SAY_RANGES.items()}
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
@@ -243,7 +251,25 @@ def read_say(
         transcript=strings["transcript"],
         audio=strings["audio"],
         visemes=visemes,
+        lang=strings["lang"],
+        voice=strings["voice"],
+        rate=numbers["rate"] if numbers["rate"] is not None else 1.0,
+        pitch=numbers["pitch"] if numbers["pitch"] is not None else 50.0,
     )
+
+
+def _ranged(
+    fields: Mapping[str, LuaValue], key: str, low: float, high: float, *, ctx: Context,
+    line: int | None,
+) -> float | None:
+    """Field ``key`` as a number in ``[low, high]`` (None when absent); FdlError otherwise."""
+    value = fields.get(key)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not low <= value <= high:
+        raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
+                       path=ctx.path, line=line)
+    return float(value)
 
 
 def _string(
