@@ -23,7 +23,7 @@ import time
 import traceback
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -55,22 +55,49 @@ class UsageError(FacelibError):
     """A command line that cannot work (wrong suffix, missing output): exit status 2."""
 
 
+@dataclass
+class Signals:
+    """The stopping signal a command received (SIGINT or SIGTERM), or None."""
+
+    received: int | None = None
+
+    def check(self) -> None:
+        """Raise KeyboardInterrupt (SIGINT) or :class:`Terminated` once one was received."""
+        if self.received == signal.SIGINT:
+            raise KeyboardInterrupt
+        if self.received is not None:
+            raise Terminated
+
+
 @dataclass(frozen=True)
 class Console:
     """Where a command's messages go: data to stdout, status and progress to stderr.
 
     quiet: only errors; verbose: also log messages (``facelib.*`` loggers) and tracebacks.
+    signals: the Ctrl-C / SIGTERM received, checked again at every progress step.
     """
 
     quiet: bool = False
     verbose: bool = False
+    signals: Signals = field(default_factory=Signals)
 
     def status(self, message: str) -> None:
         if not self.quiet:
             print(message, file=sys.stderr, flush=True)
 
-    def progress(self, label: str, *, unit: str = "frames") -> ProgressCallback | None:
-        return None if self.quiet else ConsoleProgress(label, unit=unit)
+    def progress(self, label: str, *, unit: str = "frames", show: bool = True,
+                 ) -> ProgressCallback:
+        """A progress callback (silent with ``quiet``) that also stops the job at its next
+        step once a signal came, should the signal's exception have been swallowed where
+        it landed (a destructor, a callback from C)."""
+        bar = None if self.quiet or not show else ConsoleProgress(label, unit=unit)
+
+        def report(done: int, total: int) -> None:
+            self.signals.check()
+            if bar is not None:
+                bar(done, total)
+
+        return report
 
 
 # -- outputs ---------------------------------------------------------------------------
@@ -135,8 +162,8 @@ def _source(path: str, seed: int | None, console: Console) -> Any:
         return read_fap(path)
     from facelib.animation import run_fdl
 
-    return run_fdl(path, seed=seed, progress=None if not console.verbose else
-                   console.progress("animating", unit="stages"))
+    return run_fdl(path, seed=seed,
+                   progress=console.progress("animating", unit="stages", show=console.verbose))
 
 
 # -- info --------------------------------------------------------------------------------
@@ -194,8 +221,10 @@ def _check(args: argparse.Namespace, console: Console) -> int:
     storyboard = load(args.story, seed=args.seed)
     animation = animate(storyboard, seed=args.seed)  # what run rejects, check rejects
     print(describe(storyboard))
+    target = _default_output(args.story, storyboard.output, ".fap")
     console.status(f"ok: {animation.faps.n_frames} frames at {animation.faps.fps:g} fps "
-                   f"({animation.faps.duration:.2f} s)")
+                   f"({animation.faps.duration:.2f} s); 'facelib run' without -o writes "
+                   f"{target}")
     return EXIT_OK
 
 
@@ -219,7 +248,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
 
     if args.output is not None:
         _check_suffix(args.output, (".fap",), "run")
-    animation = run_fdl(args.story, seed=args.seed)
+    animation = run_fdl(args.story, seed=args.seed,
+                        progress=console.progress("animating", unit="stages", show=False))
     out = args.output or str(_default_output(args.story, animation.storyboard.output, ".fap"))
     _check_suffix(out, (".fap",), "run")
     stream = animation.faps
@@ -814,20 +844,23 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 @contextlib.contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    """While inside, SIGTERM raises :class:`Terminated` (main thread only)."""
-    def terminate(signum: int, frame: object) -> None:
-        raise Terminated
+def _stopping_signals(signals: Signals) -> Iterator[None]:
+    """While inside, SIGINT raises KeyboardInterrupt and SIGTERM :class:`Terminated`, and
+    ``signals`` remembers which came (main thread only)."""
+    def stop(signum: int, frame: object) -> None:
+        signals.received = signum
+        signals.check()
 
     try:
-        previous = signal.signal(signal.SIGTERM, terminate)
+        previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     except ValueError:  # not the main thread: leave signals alone
         yield
         return
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def _stdout_gone() -> int:
@@ -839,20 +872,31 @@ def _stdout_gone() -> int:
     return EXIT_PIPE
 
 
+def _stopped(signum: int) -> int:
+    """One line and the exit status for a command stopped by ``signum``."""
+    if signum == signal.SIGINT:
+        print("facelib: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print("facelib: terminated", file=sys.stderr)
+    return EXIT_TERMINATED
+
+
 def _dispatch(run: Callable[[argparse.Namespace, Console], int], args: argparse.Namespace,
               console: Console) -> int:
     try:
-        with _sigterm_raises():
-            return run(args, console)
+        with _stopping_signals(console.signals):
+            status = run(args, console)
+            console.signals.check()  # a signal whose exception was swallowed on the way
+            return status
     except BrokenPipeError:
         return _stdout_gone()
     except KeyboardInterrupt:
-        print("facelib: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _stopped(signal.SIGINT)
     except Terminated:
-        print("facelib: terminated", file=sys.stderr)
-        return EXIT_TERMINATED
+        return _stopped(signal.SIGTERM)
     except FacelibError as exc:
+        if console.signals.received is not None:  # a library turned the signal into an error
+            return _stopped(console.signals.received)
         if console.verbose:
             traceback.print_exc()
         print(f"facelib: error: {exc}", file=sys.stderr)

@@ -25,6 +25,7 @@ Each clip is made in a hidden temporary folder and renamed into place when compl
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -32,7 +33,7 @@ import shutil
 import tempfile
 import time
 import tomllib
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,7 +42,7 @@ import numpy as np
 
 from facelib.atomic import write_text_atomic
 from facelib.checks import check_count, check_fps, check_number
-from facelib.errors import DataError, FacelibError, FileError, ParameterError
+from facelib.errors import FacelibError, ParameterError
 from facelib.progress import ProgressCallback, progress_callback
 
 __all__ = ["ClipDraw", "DatasetReport", "DatasetSpec", "draw_clip", "generate", "load_spec",
@@ -114,7 +115,7 @@ class DatasetSpec:
 def _pair(value: Any, key: str, path: str) -> tuple[float, float]:
     if (not isinstance(value, list) or len(value) != 2
             or not all(isinstance(v, int | float) for v in value)):
-        raise DataError(f"{key} must be a range [low, high], got {value!r}", path=path)
+        raise FacelibError(f"{key} must be a range [low, high], got {value!r}", path=path)
     return float(value[0]), float(value[1])
 
 
@@ -128,63 +129,73 @@ _SECTIONS = {
 }
 
 
-def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
-    """Read a dataset spec (TOML); FileError if it cannot be read, DataError naming the
-    file for invalid TOML, unknown keys and bad values."""
+# (section, key in the TOML) -> (DatasetSpec field, how its value is read)
+_RANGE = "range"
+_FIELDS: dict[tuple[str, str], tuple[str, str]] = {
+    ("expressions", "names"): ("expressions", "names"),
+    ("expressions", "per_clip"): ("expressions_per_clip", "counts"),
+    ("expressions", "intensity"): ("intensity", _RANGE),
+    ("gaze", "behaviours"): ("behaviours", "names"),
+    ("speech", "texts"): ("texts", "names"),
+    ("speech", "probability"): ("speech_probability", "number"),
+    ("camera", "zoom"): ("zoom", _RANGE),
+    ("camera", "shift"): ("shift", _RANGE),
+}
+
+
+def _read_toml(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
     where = str(path)
     try:
-        source = Path(path).read_text(encoding="utf-8")
+        text = Path(path).read_text(encoding="utf-8")
+        return tomllib.loads(text), text
     except OSError as exc:
-        raise FileError.wrap(exc, "read the dataset spec", where) from exc
-    try:
-        raw = tomllib.loads(source)
+        raise FacelibError(f"cannot read the dataset spec ({exc.strerror})", path=where) from None
     except tomllib.TOMLDecodeError as exc:
-        raise DataError(f"not valid TOML: {exc}", path=where) from None
-    _check_spec_keys(raw, where)
-    try:
-        return DatasetSpec(**_spec_options(raw, where), source=source)
-    except (ParameterError, TypeError) as exc:
-        raise DataError(str(exc), path=where) from None
+        raise FacelibError(f"not valid TOML: {exc}", path=where) from None
 
 
-def _check_spec_keys(raw: dict[str, Any], where: str) -> None:
+def _check_keys(raw: Mapping[str, Any], where: str) -> None:
     for key, value in raw.items():
         allowed = _SECTIONS.get(key)
         if allowed is None and key not in _TOP_KEYS:
-            raise DataError(f"unknown setting {key!r}; expected one of "
-                            f"{sorted(_TOP_KEYS | set(_SECTIONS))}", path=where)
+            raise FacelibError(f"unknown setting {key!r}; expected one of "
+                               f"{sorted(_TOP_KEYS | set(_SECTIONS))}", path=where)
         if allowed is not None and (not isinstance(value, dict) or set(value) - allowed):
-            raise DataError(f"[{key}] takes {sorted(allowed)}, got {value!r}", path=where)
+            raise FacelibError(f"[{key}] takes {sorted(allowed)}, got {value!r}", path=where)
 
 
-def _spec_options(raw: dict[str, Any], where: str) -> dict[str, Any]:
-    """DatasetSpec keyword arguments from the spec's sections."""
+def _convert(value: Any, kind: str, name: str, where: str) -> Any:
+    if kind == _RANGE:
+        return _pair(value, name, where)
+    if kind == "counts":
+        low, high = _pair(value, name, where)
+        return int(low), int(high)
+    if kind == "names":
+        if not isinstance(value, list):
+            raise FacelibError(f"{name} must be a list, got {value!r}", path=where)
+        return tuple(str(v) for v in value)
+    return value
+
+
+def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
+    """Read a dataset spec (TOML, see ``docs/batch.md``); unknown keys and bad values raise
+    FacelibError naming the file."""
+    where = str(path)
+    raw, text = _read_toml(path)
+    _check_keys(raw, where)
     options: dict[str, Any] = {k: raw[k] for k in _TOP_KEYS if k in raw}
-    expressions = raw.get("expressions", {})
-    if "names" in expressions:
-        options["expressions"] = tuple(expressions["names"])
-    if "per_clip" in expressions:
-        low, high = _pair(expressions["per_clip"], "expressions.per_clip", where)
-        options["expressions_per_clip"] = (int(low), int(high))
-    if "intensity" in expressions:
-        options["intensity"] = _pair(expressions["intensity"], "expressions.intensity", where)
-    if "behaviours" in raw.get("gaze", {}):
-        options["behaviours"] = tuple(raw["gaze"]["behaviours"])
+    for (section, key), (field_name, kind) in _FIELDS.items():
+        if key in raw.get(section, {}):
+            options[field_name] = _convert(raw[section][key], kind, f"{section}.{key}", where)
     head = raw.get("head", {})
     options["head_deg"] = tuple(
         _pair(head[k], f"head.{k}", where) if k in head else default
         for k, default in zip(("pitch_deg", "yaw_deg", "roll_deg"), _DEFAULT_HEAD_DEG,
                               strict=True))
-    speech = raw.get("speech", {})
-    if "texts" in speech:
-        options["texts"] = tuple(str(t) for t in speech["texts"])
-    if "probability" in speech:
-        options["speech_probability"] = speech["probability"]
-    camera = raw.get("camera", {})
-    for key in ("zoom", "shift"):
-        if key in camera:
-            options[key] = _pair(camera[key], f"camera.{key}", where)
-    return options
+    try:
+        return DatasetSpec(**options, source=text)
+    except (ParameterError, TypeError) as exc:
+        raise FacelibError(str(exc), path=where) from None
 
 
 @dataclass(frozen=True)
@@ -260,15 +271,17 @@ class DatasetReport:
 
 
 def _with_head(stream: Any, head_deg: Sequence[float]) -> Any:
-    """``stream`` with the head pose offset added to FAPs 48-50 in every frame."""
+    """``stream`` with the head pose offset added to FAPs 48-50 in every frame, rounded to
+    whole FAP units as ``clip.fap`` stores them, so the frames show exactly that file (and
+    last-bit differences of floating point between machines cannot reach the pixels)."""
     from facelib.mpeg4 import FapStream
 
-    values = np.array(stream.values)
+    values = np.array(stream.values, np.float64)
     mask = np.array(stream.mask)
     for fap_id, degrees in zip(_HEAD_FAPS, head_deg, strict=True):
-        values[:, fap_id - 1] += np.float32(degrees * _AU_PER_DEG)
+        values[:, fap_id - 1] += degrees * _AU_PER_DEG
         mask[:, fap_id - 1] = True
-    return FapStream(stream.fps, values, mask, stream.viseme, stream.expression)
+    return FapStream(stream.fps, np.rint(values), mask, stream.viseme, stream.expression)
 
 
 def _framing(face: Any, zoom: float, shift: Sequence[float]) -> np.ndarray:
@@ -383,21 +396,36 @@ def _clip_task(spec: DatasetSpec, index: int, out_dir: str) -> tuple[int, str, s
         return index, "failed", f"{type(exc).__name__}: {exc}"
 
 
+# Dask's nanny starts workers with these at 1; the local pool does the same, so dense
+# products sum in the same order (and the pixels match to the bit) either way.
+_ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _environment(values: Mapping[str, str]) -> Iterator[None]:
+    """``os.environ`` updated with ``values`` inside (for the processes started there)."""
+    saved = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
 def _run_local(spec: DatasetSpec, todo: Sequence[int], out_dir: str, jobs: int,
                report: ProgressCallback | None) -> list[tuple[int, str, str | None]]:
-    """The clips ``todo`` on ``jobs`` spawned worker processes (or in this one for 1)."""
+    """The clips ``todo`` on ``jobs`` spawned worker processes, one BLAS thread each."""
     import multiprocessing
 
     from facelib.batch import _raise_on_sigterm
 
     results: list[tuple[int, str, str | None]] = []
-    if jobs == 1:
-        for index in todo:
-            results.append(_clip_task(spec, index, out_dir))
-            if report is not None:
-                report(len(results), len(todo))
-        return results
-    pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_raise_on_sigterm)
+    with _environment(_ONE_THREAD):
+        pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_raise_on_sigterm)
     try:
         tasks = [(spec, i, out_dir) for i in todo]
         for result in pool.imap_unordered(_star_clip_task, tasks):

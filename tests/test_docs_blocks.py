@@ -3,8 +3,9 @@
 Storyboards (lua) go through `facelib check` and `facelib run`; Python blocks run in a fresh
 interpreter; shell lines that call `facelib` run as commands. Each runs in a scratch folder
 holding the example media, with `examples/` and `tests/` linked in so repository paths
-resolve. JSON blocks illustrate a schema with placeholders and are not run, and so is a block
-right after a ``<!-- not run: reason -->`` line (it needs files a reader makes first).
+resolve. Dataset specs (toml) are read and drawn from. JSON blocks illustrate a schema with
+placeholders and are not run, and so is a block right after a ``<!-- not run: reason -->``
+line (it needs files a reader makes first).
 """
 
 from __future__ import annotations
@@ -67,6 +68,17 @@ def test_storyboard_block_checks_and_runs(scratch, where, code, capsys):
         assert main(["run", str(story), "-o", str(scratch / "block.fap")]) == 0, (
             capsys.readouterr().err)
     assert (scratch / "block.fap").stat().st_size > 0
+
+
+@pytest.mark.parametrize(("where", "code"), blocks("toml"), ids=[w for w, _ in blocks("toml")])
+def test_dataset_spec_block_loads_and_draws(tmp_path, where, code):
+    from facelib.dataset import draw_clip, load_spec
+
+    path = tmp_path / "spec.toml"
+    path.write_text(code, encoding="utf-8")
+    spec = load_spec(path)
+    draws = [draw_clip(spec, i) for i in range(spec.clips)]
+    assert len({d.seed for d in draws}) == spec.clips
 
 
 def _run(argv: list[str], cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:

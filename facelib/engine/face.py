@@ -287,6 +287,7 @@ class Face:
         if not isinstance(stream, FapStream):
             raise ParameterError(f"deform_chunks() takes a FapStream, not {type(stream).__name__}")
         frames = check_count("frames", frames, low=1)
+        stream = apply_high_level(stream)  # FAP 1/2, as deform() does
         values = np.asarray(stream.values, dtype=np.float32)
         active = self._active(values)
         for first in range(0, values.shape[0], frames):

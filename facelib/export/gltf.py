@@ -218,8 +218,10 @@ def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: P
     b.g.animations.append(animation)
 
 
-def _copy_audio(audio: Path, out: Path) -> Path:
-    """Copy the speech ``audio`` beside ``out`` (same stem, the audio's suffix), atomically."""
+def _copy_audio(audio: Path | None, out: Path) -> Path | None:
+    """Copy the speech audio beside ``out`` (same stem), atomically; the copy's path."""
+    if audio is None:
+        return None
     copied = out.with_suffix(audio.suffix.lower())
     with atomic_path(copied) as temp:
         shutil.copyfile(audio, temp)
@@ -257,7 +259,7 @@ def export_gltf(
         values) else np.ones(len(rows), np.float32)
     dense = face.operator[rows].toarray().reshape(len(rows), face.n_vertices, 3)
     targets = (dense * scales[:, None, None]).astype(np.float32)
-    copied = None if audio_path is None else _copy_audio(audio_path, out)
+    copied = _copy_audio(audio_path, out)
     g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
     g.asset.extras = {"facelib": {
         "fps": float(stream.fps), "n_frames": int(stream.n_frames),

@@ -30,8 +30,8 @@ class Opaque:
 
 @dataclass(frozen=True, slots=True)
 class LuaTable:
-    """A Lua table: ``items`` holds keys 1..n in order, ``fields`` the string keys (in name
-    order), ``line`` the line of its constructor (None when no constructor made it)."""
+    """A Lua table: ``items`` holds keys 1..n in order, ``fields`` the string keys,
+    ``line`` the line of its constructor (None when no constructor made it)."""
 
     items: tuple[LuaValue, ...] = ()
     fields: dict[str, LuaValue] = field(default_factory=dict)
@@ -125,7 +125,6 @@ class _Copier:
             gaps = [i for i in range(1, n + 4) if i not in numbered][:3]
             raise self.fail(f"table has holes in its list part (missing positions {gaps})", here)
         items = tuple(numbered[i] for i in range(1, n + 1))
-        # Lua's hash order differs between Lua states: fields go in name order, so the same
-        # script gives the same storyboard (and reports the same first mistake) every time.
-        fields = dict(sorted(named.items()))
-        return LuaTable(items=items, fields=fields, line=here if own is not None else None)
+        # named fields in name order: Lua's hash order changes from state to state
+        return LuaTable(items=items, fields=dict(sorted(named.items())),
+                        line=here if own is not None else None)

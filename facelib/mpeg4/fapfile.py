@@ -400,10 +400,10 @@ def write_fap(
     path:
         The file to write.
     dialect:
-        ``"standard"`` (68 mask tokens, integer values: the recommended choice, read
-        correctly by Xface, Greta (Java and C++) and VREng), ``"xface"`` (standard with
-        values to 3 decimals plus the FAP 1/2 token groups; warns when it writes them:
-        Greta's Java reader and VREng shift every later value), ``"greta"`` (69 mask
+        Any of :data:`DIALECTS`, each read back as that dialect: ``"standard"`` (68 mask
+        tokens, integer values: the recommended choice, read correctly by Xface, Greta (Java
+        and C++) and VREng), ``"xface"`` (68 mask tokens, values with decimals, plus the
+        FAP 1/2 token groups: only Xface reads it right, and it warns), ``"greta"`` (69 mask
         tokens, the 69th always 0, as Greta writes), ``"vreng"`` (standard with frames
         numbered from 1, tab-separated) or ``"extended"`` (84 mask tokens with facelib's
         FAPs 69-84, plus FAP 1/2; only facelib reads it). Every dialect but ``extended``
@@ -432,9 +432,9 @@ def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "fac
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
     _check_range(stream)
     label = "_".join(name.split()) or "facelib"
+    _warn_dropped(stream, label, dialect)
     width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
-    _warn_dropped(stream, label, dialect)
     values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
         str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
     first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
@@ -468,32 +468,36 @@ def _decimal(value: float) -> str:
     return text + "0" if text.endswith(".") else text
 
 
-def _warn_dropped(stream: FapStream, path: str, dialect: str) -> None:
-    """Warn about what a dialect cannot carry: extended FAPs 69-84 outside ``extended``, and
-    the FAP 1/2 token groups of ``xface`` that Greta's Java reader and VREng misread."""
+def _warn_dropped(stream: FapStream, label: str, dialect: str) -> None:
+    """Warn (naming the file's header ``label``) about what a dialect's players cannot read
+    (shared/reference/fap_players.md): extended FAPs 69-84 outside ``extended``, Greta's
+    fixed 25 fps, Greta C++'s 8000-frame limit with FAP 1/2, and ``xface`` in any reader but
+    Xface's."""
     if dialect != "extended":
-        used = (stream.mask[:, N_STANDARD_FAPS:] & (stream.values[:, N_STANDARD_FAPS:] != 0))
+        used = stream.mask[:, N_STANDARD_FAPS:] & (stream.values[:, N_STANDARD_FAPS:] != 0)
         dropped = [int(i) + N_STANDARD_FAPS + 1 for i in np.flatnonzero(used.any(axis=0))]
         if dropped:
             warnings.warn(
-                f"{path}: the {dialect} dialect has no extended FAPs; dropping FAP "
+                f"{label}: the {dialect} dialect has no extended FAPs; dropping FAP "
                 f"{', '.join(map(str, dropped))} (write dialect='extended' to keep them; "
-                "only facelib reads that dialect)", FacelibWarning, stacklevel=3)
+                "only facelib reads that dialect)", FacelibWarning, stacklevel=4)
     if dialect == "greta" and stream.fps != _GRETA_FPS:
         warnings.warn(
-            f"{path}: Greta's Java reader ignores the header's frame rate and plays "
+            f"{label}: Greta's Java reader ignores the header's frame rate and plays "
             f"{_GRETA_FPS} fps; this stream has {stream.fps:g} fps (resample it: "
-            f"stream.resample({_GRETA_FPS}))", FacelibWarning, stacklevel=3)
-    high_level = stream.mask[:, :2].any() and (
+            f"stream.resample({_GRETA_FPS}))", FacelibWarning, stacklevel=4)
+    high_level = bool(stream.mask[:, :2].any()) and (
         stream.viseme is not None or stream.expression is not None)
     if high_level and dialect in ("xface", "extended") and stream.n_frames > _GRETA_CPP_FRAMES:
         warnings.warn(
-            f"{path}: {stream.n_frames} frames with FAP 1/2: Greta's C++ reader keeps them in "
+            f"{label}: {stream.n_frames} frames with FAP 1/2: Greta's C++ reader keeps them in "
             f"arrays of {_GRETA_CPP_FRAMES} frames and crashes on longer files",
-            FacelibWarning, stacklevel=3)
-    if dialect == "xface" and high_level:
+            FacelibWarning, stacklevel=4)
+    if dialect == "xface":
+        groups = ("; its FAP 1/2 token groups shift every later value of the frame in Greta "
+                  "Java and VREng" if high_level else "")
         warnings.warn(
-            f"{path}: the xface dialect writes FAP 1/2 as 4- and 6-token groups, which Greta's "
-            "Java reader and VREng read as one token each, shifting every later value of "
-            "the frame; dialect='standard' is read correctly by every player",
-            FacelibWarning, stacklevel=3)
+            f"{label}: only Xface reads the xface dialect right: Greta's Java reader loses "
+            "every frame on its decimal values and Greta's C++ reader every value after the "
+            f"first decimal{groups}; dialect='standard' is read correctly by every player",
+            FacelibWarning, stacklevel=4)

@@ -64,8 +64,8 @@ class Playback:
 
 
 def _keys(state: Playback) -> dict[Any, Any]:
-    """pyrender's ``registered_keys``: space pauses, left/right step one frame, up/down
-    ten (pyrender keeps its own: q quits, z resets the view)."""
+    """pyrender's ``registered_keys`` by pyglet key symbol: space pauses, left/right step one
+    frame, up/down ten (pyrender keeps its own: q quits, z resets the view)."""
     from pyglet.window import key
 
     return {
@@ -77,18 +77,27 @@ def _keys(state: Playback) -> dict[Any, Any]:
     }
 
 
-def _sound(audio: Path | None, offset: float) -> Any:
-    """A started pyglet player for ``audio`` (None without audio or an audio device)."""
-    if audio is None or offset < 0:
+def _sound(audio: Path | None) -> Any:
+    """A pyglet player holding ``audio`` (read with soundfile, so any format it reads
+    plays), or None without audio. Without an audio device pyglet's silent driver takes
+    it, so playback and its clock run the same way, without sound."""
+    if audio is None:
         return None
     try:
-        import pyglet.media
+        import io
 
-        source = pyglet.media.load(str(audio), streaming=False)
+        import pyglet.media
+        import soundfile
+
+        samples, rate = soundfile.read(str(audio), dtype="int16", always_2d=True)
+        wav = io.BytesIO()
+        soundfile.write(wav, samples, rate, format="WAV", subtype="PCM_16")
+        wav.seek(0)  # pyglet decodes WAV itself; other formats would need its FFmpeg codec
+        source = pyglet.media.load("speech.wav", file=wav, streaming=False)
         player = pyglet.media.Player()
         player.queue(source)
         return player
-    except Exception:  # no driver, no device, unreadable: play silently  # noqa: BLE001
+    except Exception:  # no driver, unreadable audio: play without sound  # noqa: BLE001
         return None
 
 
@@ -131,13 +140,15 @@ def view(
     try:
         viewer = pr.Viewer(
             scene.scene, viewport_size=(width, height), run_in_thread=True,
-            registered_keys=_keys(state),
             window_title=f"facelib: {stream.n_frames} frames at {stream.fps:g} fps",
         )
     except Exception as exc:
         raise RenderError(f"could not open a window ({type(exc).__name__}: {exc})") from exc
+    # set after construction: pyrender's constructor only maps ASCII characters, the
+    # property takes pyglet key symbols (arrows included)
+    viewer.registered_keys = {**viewer.registered_keys, **_keys(state)}
     frames = np.asarray(face.deform(stream), np.float32) if stream.n_frames else None
-    player = _sound(audio, offset) if sound else None
+    player = _sound(audio) if sound else None
     try:
         while frames is not None and viewer.is_active:
             _play_once(viewer, scene, frames, state, player=player, offset=offset)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from pathlib import Path
 
 import pytest
 
@@ -13,8 +14,8 @@ BAD = [
     ('look { "lookAt", dur = 1 }', 2, "unknown eye behaviour 'lookAt'"),
     ('look { "lookTo", "left", 15.0, "yes", 3, 4, dur = 1 }', 2, "lookTo takes at most 3"),
     ('look { "lookTo", "sideways", 15.0, "yes", dur = 1 }', 2, "unknown direction 'sideways'"),
-    (('define_gaze { "nervous", like = "default", blink_rate = 0.6 }\n'
-      'look { "nervous", dur = 3 }'), 2, "eye behaviour 'nervous': unknown key"),
+    ('define_gaze { "nervous", blink_rate = 0.6 }\nlook { "nervous", dur = 3 }',
+     2, "eye behaviour 'nervous': unknown key"),
 ]
 
 
@@ -47,3 +48,4 @@ def test_check_passes_a_good_storyboard_with_its_length(tmp_path, capsys):
     captured = capsys.readouterr()
     assert "joy" in captured.out and "nervous" in captured.out
     assert "ok: 51 frames at 25 fps (2.04 s)" in captured.err
+    assert f"without -o writes {Path.cwd() / 'good.fap'}" in captured.err

@@ -135,7 +135,7 @@ def test_signals_exit_with_one_line_and_no_temporary_files(tmp_path, sig, status
     time.sleep(0.3)
     proc.send_signal(sig)
     err = proc.stderr.read().decode()
-    assert proc.wait(timeout=60) == status
+    assert proc.wait(timeout=60) == status, err
     assert err.strip().splitlines()[-1] == f"facelib: {word}"
     assert "Traceback" not in err
     assert list(out_dir.iterdir()) == []

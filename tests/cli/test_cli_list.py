@@ -50,3 +50,11 @@ def test_reprs_are_one_short_line():
         assert "\n" not in text and len(text) < 200
     assert repr(face).startswith("Face(vertices=")
     assert "active_faps=0" in repr(stream)
+
+
+def test_the_docs_viseme_names_are_the_ones_align_writes():
+    from facelib.mpeg4.visemes import script_name
+
+    text = (ROOT / "docs" / "fdl.md").read_text()
+    listed = re.search(r"the thesis's `(silence [^`]+)`", text).group(1).split()
+    assert listed == [script_name(i) for i in range(15)]

@@ -57,7 +57,7 @@ def test_xface_groups_warn_and_standard_does_not(tmp_path):
     mask = np.zeros((2, 84), bool)
     mask[:, :3] = True
     stream = FapStream(25, values, mask, np.array([[1, 2, 30, 0]] * 2), None)
-    with pytest.warns(FacelibWarning, match="Greta's Java reader and VREng"):
+    with pytest.warns(FacelibWarning, match="shift every later value .* Greta Java and VREng"):
         write_fap(stream, tmp_path / "x.fap", dialect="xface")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -91,6 +91,8 @@ def test_a_file_with_only_fap_1_and_2_animates_the_face():
     plain = FapStream(stream.fps, stream.values, stream.mask & ~np.eye(84, dtype=bool)[0:1]
                       & ~np.eye(84, dtype=bool)[1:2])
     assert np.abs(moved - (face.deform(plain) - face.vertices)).max() > 1e-3  # > 1 mm
+    chunks = np.concatenate([v for _, v in face.deform_chunks(stream, frames=2)])
+    np.testing.assert_array_equal(chunks, face.deform(stream))
 
 
 def test_warnings_for_greta_frame_rate_and_long_high_level_files(tmp_path):
