@@ -3,14 +3,15 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 EXTRAS ?= all
+MINIMAL_VENV ?= .venv-minimal
 
-.PHONY: demo test setup lint bench clean web
+.PHONY: demo test setup lint minimal bench clean web
 WEB := facelib/export/web
 
 demo: $(VENV)/.installed
 	$(BIN)/facelib render examples/hello/hello.fdl -o out/hello.mp4 --fap out/hello.fap
 
-test: lint $(WEB)/dist/player.js
+test: lint minimal $(WEB)/dist/player.js
 	$(BIN)/python -m pytest
 
 setup: $(VENV)/.installed $(WEB)/dist/player.js
@@ -40,6 +41,19 @@ lint: $(VENV)/.installed
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 
+# The core pipeline (storyboard -> .fap) in a virtualenv with none of the extras. The
+# venv is kept (rebuilt when pyproject.toml changes; facelib is installed editable), so a
+# rerun costs seconds.
+minimal: $(MINIMAL_VENV)/.installed
+	$(MINIMAL_VENV)/bin/python tools/minimal_install_check.py
+
+$(MINIMAL_VENV)/.installed: pyproject.toml
+	rm -rf $(MINIMAL_VENV)
+	$(PYTHON) -m venv $(MINIMAL_VENV)
+	$(MINIMAL_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(MINIMAL_VENV)/bin/python -m pip install --quiet -e .
+	touch $@
+
 # Figures, not pass/fail: each benchmark prints what it measured.
 bench: $(VENV)/.installed
 	for b in engine_deform engine_deformers engine_setup render_speed gaze_simulate fdl_sandbox \
@@ -47,4 +61,5 @@ bench: $(VENV)/.installed
 		PYTHONPATH=. $(BIN)/python benchmarks/$$b.py || exit 1; done
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache $(WEB)/node_modules $(WEB)/dist
+	rm -rf $(VENV) $(MINIMAL_VENV) build *.egg-info .pytest_cache .ruff_cache .mypy_cache \
+		$(WEB)/node_modules $(WEB)/dist

@@ -12,7 +12,7 @@ from facelib import fdl
 from facelib.errors import FdlError
 from facelib.fdl.sandbox import Sandbox
 
-DATA = Path(__file__).parents[1] / "tests" / "fdl" / "data" / "thesis"
+DATA = Path(__file__).parents[1] / "tests" / "data" / "fdl" / "thesis"
 
 
 def timed(label: str, fn, repeat: int = 5) -> None:

@@ -11,12 +11,23 @@ from __future__ import annotations
 import difflib
 import math
 from collections.abc import Iterable
+from typing import TypeVar
 
 import numpy as np
 
 from facelib.errors import ParameterError
 
-__all__ = ["check_count", "check_fps", "check_number", "check_seed", "did_you_mean"]
+__all__ = [
+    "check_count",
+    "check_fps",
+    "check_items",
+    "check_kind",
+    "check_number",
+    "check_seed",
+    "did_you_mean",
+]
+
+T = TypeVar("T")
 
 
 def check_number(name: str, value: object, *, low: float | None = None,
@@ -63,6 +74,28 @@ def check_seed(seed: object) -> int:
     ):
         raise ParameterError(f"seed must be an integer from 0 to 2^63-1, got {seed!r}")
     return int(seed)
+
+
+def check_kind(name: str, value: object, kind: type[T]) -> T:
+    """``value`` if it is a ``kind``; ``ParameterError`` naming what it is otherwise."""
+    if not isinstance(value, kind):
+        raise ParameterError(f"{name} must be a {kind.__name__}, got {type(value).__name__} "
+                             f"{value!r:.60}")
+    return value
+
+
+def check_items(name: str, values: object, kind: type[T]) -> list[T]:
+    """``values`` (any iterable but a string) as a list of ``kind``; ``ParameterError``
+    naming the first item of another type."""
+    if isinstance(values, str | bytes) or not isinstance(values, Iterable):
+        raise ParameterError(f"{name} must be a sequence of {kind.__name__}, got "
+                             f"{type(values).__name__}")
+    out = list(values)
+    for i, item in enumerate(out):
+        if not isinstance(item, kind):
+            raise ParameterError(f"{name}[{i}] must be a {kind.__name__}, got "
+                                 f"{type(item).__name__} {item!r:.60}")
+    return out
 
 
 def did_you_mean(word: str, choices: Iterable[str], *, cutoff: float = 0.7) -> str:

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 import facelib
-from facelib.errors import FacelibError
+from facelib.errors import FacelibError, FileError
 from facelib.mpeg4 import FapStream, fap, format_fap, read_fap, read_fap_file, write_fap
 from facelib.progress import ConsoleProgress, ProgressCallback
 
@@ -451,7 +451,10 @@ def _align(args: argparse.Namespace, console: Console) -> int:
     kind = "sb" if kind in ("lua", "fdl") else kind
     text = args.text
     if args.text_file is not None:
-        text = Path(args.text_file).read_text(encoding="utf-8")
+        try:
+            text = Path(args.text_file).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise FileError(f"cannot read the transcript: {exc}", path=args.text_file) from exc
     if args.lang.lower().startswith("en"):
         timeline = align(args.audio, text)
     elif text is None:

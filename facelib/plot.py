@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from facelib.atomic import atomic_path
-from facelib.errors import MissingExtraError
+from facelib.errors import MissingExtraError, ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap, fap_groups, fap_table
 
@@ -60,6 +60,10 @@ def plot_curves(
         import matplotlib.pyplot as plt
     except ImportError as exc:
         raise MissingExtraError("plotting", "plot", "matplotlib") from exc
+    if not isinstance(source, FapStream) and not isinstance(getattr(source, "faps", None),
+                                                            FapStream):
+        raise ParameterError(f"plot_curves takes a FapStream or an Animation, not "
+                             f"{type(source).__name__}")
     stream: FapStream = source if isinstance(source, FapStream) else source.faps
     storyboard = getattr(source, "storyboard", None)
     moving = set(np.flatnonzero(stream.values.any(axis=0)) + 1)

@@ -81,6 +81,31 @@ CASES: list[tuple[str, Callable[[Path], object], type[FacelibError], str]] = [
     ("timeline fps 0", lambda _: visemes.timeline_to_sentence(
         visemes.timeline_from_text("hi"), fps=0),
      ParameterError, "fps must be a positive number"),
+    # storyboards: API arguments are ParameterErrors, script problems FdlErrors
+    ("loads bytes", lambda _: fdl.loads(b"show {}"), ParameterError, "must be a str"),
+    ("loads base_dir", lambda tmp: fdl.loads("x = 1", base_dir=_a_file(tmp)),
+     ParameterError, "is not a folder"),
+    ("sandbox memory", lambda _: fdl.Sandbox(max_memory=10),
+     ParameterError, "max_memory must be an integer >= 1048576"),
+    ("sandbox seconds", lambda _: fdl.Sandbox(max_seconds=0),
+     ParameterError, "max_seconds must be a finite number in (0, 3600]"),
+    ("script line", lambda _: fdl.loads("x = 1\nfps = -5", name="s.fdl"),
+     FdlError, "s.fdl:2: fps must be a number from 1 to 1000"),
+    # wrong kinds of arguments
+    ("expression cues not a list", lambda _: expressions.animate(5, fps=25, n_frames=3),
+     ParameterError, "cues must be a sequence of ExpressionCue"),
+    ("gaze cue of the wrong kind", lambda _: gaze.animate(JOY, fps=25, n_frames=3, seed=0),
+     ParameterError, "cues[0] must be a GazeCue, got ExpressionCue"),
+    ("visemes not a SpeechSpec", lambda _: visemes.animate("hello", fps=25),
+     ParameterError, "speech must be a SpeechSpec, got str"),
+    ("text not a str", lambda _: visemes.timeline_from_text(5), ParameterError,
+     "text must be a str"),
+    ("write_fap not a stream", lambda tmp: write_fap("x", tmp / "a.fap"), ParameterError,
+     "stream must be a FapStream"),
+    ("deform_frame text", lambda _: facelib.load_face().deform_frame("x"), ParameterError,
+     "needs 84 FAP values"),
+    ("between nan", lambda _: STREAM.between(float("nan"), 1), ParameterError,
+     "start must be a finite number"),
     # streams and tracks
     ("stream shape", lambda _: FapStream(25, np.zeros((2, 80))),
      ParameterError, "values must have shape (n_frames, 84)"),
@@ -177,3 +202,36 @@ def test_the_table_names_each_error_class():
     named = {c[2] for c in CASES}
     assert {ParameterError, FdlError, FileError, DataError, FapFormatError,
             SpeechError} <= named
+
+
+# The command line: the same errors, reported on one line with exit status 1.
+CLI_CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
+    ("info missing", lambda tmp: ["info", str(tmp / "none.fap")], "none.fap"),
+    ("run missing", lambda tmp: ["run", str(tmp / "none.fdl")], "not found"),
+    ("run into a file", lambda tmp: ["run", str(_story(tmp)), "-o",
+                                      str(_a_file(tmp) / "x.fap")], "cannot write"),
+    ("align transcript missing", lambda tmp: ["align", str(tmp / "a.wav"), "--text-file",
+                                              str(tmp / "none.txt"), "-o", str(tmp / "o.sb")],
+     "none.txt: cannot read the transcript"),
+    ("check misspelt", lambda tmp: ["check", str(_story(tmp, 'shwo { "joy", dur = 1 }'))],
+     "did you mean 'show'"),
+    ("run misspelt expression", lambda tmp: ["run", str(_story(tmp, 'show { "joyy", dur = 1 }')),
+                                             "-o", str(tmp / "o.fap")],
+     "s.fdl:1: unknown expression 'joyy'; did you mean 'joy'?"),
+]
+
+
+def _story(tmp: Path, text: str = 'show { "joy", dur = 1 }') -> Path:
+    return _write(tmp, "s.fdl", text)
+
+
+@pytest.mark.parametrize(("argv", "fragment"), [c[1:] for c in CLI_CASES],
+                         ids=[c[0] for c in CLI_CASES])
+def test_bad_input_on_the_command_line(tmp_path, capsys, argv, fragment):
+    from facelib.cli import main
+
+    assert main(argv(tmp_path)) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("facelib: error: ")
+    assert fragment in err
+    assert "Traceback" not in err

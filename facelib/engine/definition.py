@@ -123,13 +123,13 @@ class _Reader:
         vertices, triangles, colours = self.mesh()
         nv = len(vertices)
         parts = self.parts(nv)
-        fps = self.feature_points(nv)
+        points = self.feature_points(nv)
         pivots = self.pivots()
-        regions = self.regions(nv, fps, pivots)
+        regions = self.regions(nv, points, pivots)
         neck = self.neck()
         try:
             return Face.build(vertices=vertices, triangles=triangles, vertex_colors=colours,
-                              parts=parts, feature_points=fps, regions=regions, pivots=pivots,
+                              parts=parts, feature_points=points, regions=regions, pivots=pivots,
                               neck=neck)
         except FaceModelError as exc:
             raise self.fail(exc.message) from exc

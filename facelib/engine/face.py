@@ -46,9 +46,22 @@ __all__ = ["PART_NAMES", "Face", "Part", "Region"]
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
 RIGID_DEFORMERS = ("eyelid",)
 """Deformers that are per-frame rigid steps of the face, not entries of the registry."""
-_EYELID_FAPS = {"3.1": 19, "3.2": 20, "3.3": 21, "3.4": 22}
-_EYES = (("eye_l", 23, 25, 27), ("eye_r", 24, 26, 28))
+# The rigid steps address FAPs by their names in the standard's table (facelib.mpeg4).
+# Eyelid feature point -> the FAP that closes that lid (step 2).
+_EYELID_FAPS = {"3.1": "close_t_l_eyelid", "3.2": "close_t_r_eyelid",
+                "3.3": "close_b_l_eyelid", "3.4": "close_b_r_eyelid"}
+# Eyeball part -> its yaw, pitch and thrust FAPs (step 3).
+_EYES = (("eye_l", "yaw_l_eyeball", "pitch_l_eyeball", "thrust_l_eyeball"),
+         ("eye_r", "yaw_r_eyeball", "pitch_r_eyeball", "thrust_r_eyeball"))
+_EYE_THRUSTS = frozenset(thrust for *_, thrust in _EYES)
+_JAW = ("open_jaw", "thrust_jaw", "shift_jaw")  # step 4; open_jaw moves point 2.1
+_HEAD = ("head_pitch", "head_yaw", "head_roll")  # step 5
 _BLOCK = 32  # frames deformed together
+
+
+def _column(name: str) -> int:
+    """The 0-based column of the FAP called ``name`` in a frame of 84 values."""
+    return fap(name).index
 
 
 def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
@@ -150,7 +163,7 @@ class _Rigid:
 
     lids: _Lids
     # per eye: columns (3K,), rest shape about the centre (K, 3) float32, the centre
-    # repeated (3K,) float32, FAP numbers of yaw, pitch and thrust
+    # repeated (3K,) float32, 0-based FAP columns of yaw, pitch and thrust
     eyes: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, int, int, int], ...]
     jaw_x: np.ndarray
     jaw_y: np.ndarray
@@ -222,11 +235,11 @@ class Face:
         """
         verts = _readonly(vertices, np.float32)
         tris = _readonly(triangles, np.int32)
-        fps = MappingProxyType(dict(feature_points))
-        fapu = MappingProxyType(compute_fapu(verts, fps))
+        points = MappingProxyType(dict(feature_points))
+        fapu = MappingProxyType(compute_fapu(verts, points))
         part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
-        operator, steps = _compile(verts, tris, fps, fapu, regions)
+        operator, steps = _compile(verts, tris, points, fapu, regions)
         for region in regions:
             for eye in ("eye_l", "eye_r"):
                 if np.isin(region.vertices, part_map[eye].vertex_ids).any():
@@ -236,14 +249,14 @@ class Face:
                     )
         columns = np.unique(operator.indices).astype(np.int64)
         dense = operator[:, columns].toarray().astype(np.float32)
-        rigid_parts = _rigid(verts, fps, fapu, regions=regions, parts=part_map,
+        rigid_parts = _rigid(verts, points, fapu, regions=regions, parts=part_map,
                              pivots=pivot_map, neck=neck, operator=operator)
         return cls(
             vertices=verts,
             triangles=tris,
             vertex_colors=_readonly(vertex_colors, np.float32),
             parts=MappingProxyType(part_map),
-            feature_points=fps,
+            feature_points=points,
             fapu=fapu,
             regions=tuple(regions),
             pivots=MappingProxyType(pivot_map),
@@ -314,7 +327,11 @@ class Face:
 
     def deform_frame(self, values: np.ndarray) -> np.ndarray:
         """Vertex positions for one frame of 84 FAP values: ``(84,) -> (V, 3) float32``."""
-        values = np.asarray(values, dtype=np.float32)
+        try:
+            values = np.asarray(values, dtype=np.float32)
+        except (TypeError, ValueError):
+            raise ParameterError(f"deform_frame() needs 84 FAP values, got {values!r:.60}"
+                                 ) from None
         if values.shape != (N_FAPS,):
             raise ParameterError(f"deform_frame() needs 84 FAP values, got shape {values.shape}")
         if not np.all(np.isfinite(values)):
@@ -364,7 +381,7 @@ class Face:
         au = self.fapu["AU"]
         flat = pos.reshape(len(f), -1)
         for columns, local, tiled, yaw, pitch, thrust in self._rigid.eyes:
-            y, p, t = f[:, yaw - 1] * au, f[:, pitch - 1] * au, f[:, thrust - 1]
+            y, p, t = f[:, yaw] * au, f[:, pitch] * au, f[:, thrust]
             if not (y.any() or p.any() or t.any()):
                 continue
             rot = rigid.rotation_matrices(p, y, np.zeros_like(p)).astype(np.float32)
@@ -375,7 +392,7 @@ class Face:
 
     def _move_jaw(self, pos: np.ndarray, f: np.ndarray) -> None:
         r = self._rigid
-        open_, thrust, shift = f[:, 2], f[:, 13], f[:, 14]
+        open_, thrust, shift = (f[:, _column(name)] for name in _JAW)
         if not (open_.any() or thrust.any() or shift.any()):
             return
         flat = pos.reshape(len(f), -1)
@@ -390,7 +407,7 @@ class Face:
         """Rotate the block ``pos`` about the head pivot into ``out`` (same shape)."""
         r = self._rigid
         au = self.fapu["AU"]
-        pitch, yaw, roll = f[:, 47] * au, f[:, 48] * au, f[:, 49] * au
+        pitch, yaw, roll = (f[:, _column(name)] * au for name in _HEAD)
         if not (pitch.any() or yaw.any() or roll.any()):
             out[:] = pos
             return
@@ -410,9 +427,9 @@ def _fp_motion(fapu: Mapping[str, float]) -> dict[str, list[tuple[int, np.ndarra
     FAP that moves it through the operator (eq. 4.6)."""
     out: dict[str, list[tuple[int, np.ndarray]]] = {}
     for f in fap_table():
-        if f.kind != "translation" or f.fapu not in fapu or f.id in _EYELID_FAPS.values():
+        if f.kind != "translation" or f.fapu not in fapu or f.name in _EYELID_FAPS.values():
             continue
-        if f.id in (27, 28):  # eyeball thrust moves the whole eye (rigid step)
+        if f.name in _EYE_THRUSTS:  # eyeball thrust moves the whole eye (rigid step)
             continue
         scale = fapu[f.fapu] * np.asarray(f.direction, dtype=np.float64)
         out.setdefault(f.feature_points[0], []).append((f.index, scale))
@@ -449,13 +466,13 @@ def _jaw_drop(operator: sp.csr_array, point: int, mns: float) -> float:
 
 
 def _region_weights(
-    region: Region, pos: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int]
+    region: Region, pos: np.ndarray, triangles: np.ndarray, points: Mapping[str, int]
 ) -> tuple[np.ndarray, FrameStep | None]:
     """``(Vr, 3, N, 3)`` weights of one region and its exact step (None when linear)."""
     algo = region.algorithm
     setup = RegionSetup(
         name=region.name, members=region.vertices.astype(np.int64),
-        controls=np.array([fps[f] for f in region.feature_points], np.int64),
+        controls=np.array([points[p] for p in region.feature_points], np.int64),
         anchors=region.anchors.astype(np.int64), vertices=pos, triangles=triangles,
         weights=region.weights.astype(np.float64),
         params=MappingProxyType(algo.resolve(region.params, region=region.name)),
@@ -472,7 +489,7 @@ def _region_weights(
 
 
 def _compile(
-    verts: np.ndarray, triangles: np.ndarray, fps: Mapping[str, int],
+    verts: np.ndarray, triangles: np.ndarray, points: Mapping[str, int],
     fapu: Mapping[str, float], regions: tuple[Region, ...],
 ) -> tuple[sp.csr_array, tuple[_Step, ...]]:
     """The (84, 3V) operator: displacement of each vertex coordinate per unit of each FAP,
@@ -488,7 +505,7 @@ def _compile(
     for region in regions:
         if region.deformer in RIGID_DEFORMERS:
             continue
-        w, step = _region_weights(region, pos, tris, fps)
+        w, step = _region_weights(region, pos, tris, points)
         members = region.vertices.astype(np.int64)
         mine = {fap(region.field_fap).index} if region.field_fap else None
         # g: (84, N, 3) control displacement per FAP unit
@@ -517,7 +534,7 @@ def _compile(
 
 
 def _lids(
-    verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
+    verts: np.ndarray, points: Mapping[str, int], fapu: Mapping[str, float],
     regions: tuple[Region, ...], pivots: Mapping[str, np.ndarray],
 ) -> _Lids:
     lid_regions = [r for r in regions if r.deformer == "eyelid"]
@@ -545,7 +562,7 @@ def _lids(
         # the FAP prescribes the vertical motion of the lid point; sliding over the eye,
         # the rotation decides its depth
         hinges.append((f.index, fapu[f.fapu] * f.direction[1], pivots[region.pivot],
-                       verts[fps[fp_id]].astype(np.float64)))
+                       verts[points[fp_id]].astype(np.float64)))
     centres = np.array([pivots[name] for name in pivot_of], np.float32).reshape(-1, 3)
     return _Lids(tuple(hinges), _columns(ids, "y"), _columns(ids, "z"), centres[:, 1],
                  centres[:, 2], weights)
@@ -563,7 +580,7 @@ def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
     return out
 
 
-def _rigid(verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float], *,
+def _rigid(verts: np.ndarray, points: Mapping[str, int], fapu: Mapping[str, float], *,
            regions: tuple[Region, ...], parts: Mapping[str, Part],
            pivots: Mapping[str, np.ndarray], neck: tuple[np.ndarray, np.ndarray, float],
            operator: sp.csr_array) -> _Rigid:
@@ -576,20 +593,20 @@ def _rigid(verts: np.ndarray, fps: Mapping[str, int], fapu: Mapping[str, float],
     jaw_ids = np.concatenate(
         [parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
     return _Rigid(
-        lids=_lids(verts, fps, fapu, regions, pivots),
+        lids=_lids(verts, points, fapu, regions, pivots),
         eyes=tuple(
             (_columns(parts[name].vertex_ids),
              (verts[parts[name].vertex_ids] - pivots[name]).astype(np.float32),
              np.tile(pivots[name].astype(np.float32), parts[name].vertex_ids.size),
-             yaw, pitch, thrust)
+             _column(yaw), _column(pitch), _column(thrust))
             for name, yaw, pitch, thrust in _EYES
         ),
         jaw_x=_columns(jaw_ids, "x"),
         jaw_y=_columns(jaw_ids, "y"),
         jaw_z=_columns(jaw_ids, "z"),
         jaw_pivot=pivots["jaw"],
-        chin=verts[fps["2.3"]].astype(np.float64),
-        chin_drop=_jaw_drop(operator, fps["2.3"], fapu["MNS"]),
+        chin=verts[points["2.3"]].astype(np.float64),
+        chin_drop=_jaw_drop(operator, points["2.3"], fapu["MNS"]),
         head_pivot=head,
         head_tiled=np.tile(head.astype(np.float32), len(verts)),
         head_weights=head_w[head_w < 1.0].astype(np.float32),

@@ -108,12 +108,12 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         part_of[ids] = name
         local_of[ids] = np.arange(ids.size)
     mapper = _Mapper(blocks, part_of, local_of)
-    fps = mapper.feature_points(source.feature_points, landmark_vertices)
-    regions = tuple(mapper.region(r, fps) for r in source.regions)
+    points = mapper.feature_points(source.feature_points, landmark_vertices)
+    regions = tuple(mapper.region(r, points) for r in source.regions)
     return Face.build(
         vertices=np.concatenate(positions), triangles=np.concatenate(triangles),
         vertex_colors=np.clip(np.concatenate(colours), 0, 1),
-        parts=_part_ranges(positions), feature_points=fps, regions=regions,
+        parts=_part_ranges(positions), feature_points=points, regions=regions,
         pivots=_pivots(source, tps, blocks, positions), neck=_neck(source, tps))
 
 
@@ -202,17 +202,17 @@ class _Mapper:
                 out[parts == name] = block.offset + local
         return out
 
-    def feature_points(self, fps: Mapping[str, int],
+    def feature_points(self, points: Mapping[str, int],
                        given: Mapping[str, tuple[str, int]]) -> dict[str, int]:
         """Each feature point on its own output vertex (given landmark vertices first)."""
         out: dict[str, int] = {}
         taken: set[int] = set()
         for fp_id, (part, vertex) in given.items():
             block = self.blocks[part]
-            if part == self.part_of[fps[fp_id]] and isinstance(block, _Dense):
+            if part == self.part_of[points[fp_id]] and isinstance(block, _Dense):
                 out[fp_id] = block.offset + vertex
                 taken.add(out[fp_id])
-        for fp_id, v in fps.items():
+        for fp_id, v in points.items():
             if fp_id in out:
                 continue
             block = self.blocks[str(self.part_of[v])]
@@ -228,7 +228,7 @@ class _Mapper:
             taken.add(out[fp_id])
         return out
 
-    def region(self, region: Region, fps: Mapping[str, int]) -> Region:
+    def region(self, region: Region, points: Mapping[str, int]) -> Region:
         members, weights, moves = [], [], []
         for name, sub in self._by_part(region.vertices.astype(np.int64)).items():
             block = self.blocks[name]
@@ -268,10 +268,10 @@ class _Mapper:
         d = (np.concatenate(moves)[order][first] if moves
              else np.zeros((0, 3))).astype(np.float32)
         if region.deformer == "field":
-            ids, d = _with_point(ids, d, fps[region.feature_points[0]], self)
+            ids, d = _with_point(ids, d, points[region.feature_points[0]], self)
         anchors = np.zeros(0, np.int64)
         if region.anchors.size:
-            controls = [fps[f] for f in region.feature_points]
+            controls = [points[f] for f in region.feature_points]
             anchors = np.setdiff1d(self.nearest(region.anchors.astype(np.int64)),
                                    np.concatenate([ids, controls]))
         return Region(name=region.name, deformer=region.deformer,

@@ -9,7 +9,7 @@ from typing import Literal
 import numpy as np
 
 from facelib import data
-from facelib.checks import check_count, check_fps
+from facelib.checks import check_count, check_fps, check_items
 from facelib.cues import ExpressionCue
 from facelib.errors import DataError, FdlError, ParameterError
 from facelib.expressions.library import ExpressionLibrary, default_library
@@ -99,6 +99,7 @@ def animate(
 
     Returns a :class:`FapTrack` of ``n_frames`` at ``fps``.
     """
+    cues = check_items("cues", cues, ExpressionCue)
     fps = check_fps(fps)
     n_frames = check_count("n_frames", n_frames)
     library = library or default_library()

@@ -9,7 +9,7 @@ dispatches each recorded call to its reader, the readers check named fields agai
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -105,7 +105,7 @@ def known_globals() -> tuple[str, ...]:
 
 
 def read_calls(
-    calls: list[tuple[str, object, int | None, int]], ctx: Context
+    calls: Sequence[tuple[str, object, int | None, int]], ctx: Context
 ) -> modern.ModernParts:
     """Validate recorded calls ``(function, argument, line, n_arguments)`` into parts."""
     parts = modern.ModernParts()

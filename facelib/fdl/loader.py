@@ -17,11 +17,11 @@ import logging
 import math
 import warnings
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TypeVar
 
 from facelib.checks import did_you_mean
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard
-from facelib.errors import FdlError, FdlWarning
+from facelib.errors import FdlError, FdlWarning, ParameterError
 from facelib.fdl import modern_cues, thesis_cues
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.functions import SETTINGS, function_names, known_globals, read_calls
@@ -30,7 +30,7 @@ from facelib.fdl.paths import read_text, resolve_inside
 from facelib.fdl.sandbox import WHITELIST, ChunkResult, Sandbox
 from facelib.fdl.thesis import SCRIPT_GLOBALS, check_fdl_table
 from facelib.fdl.thesis_cues import ThesisList
-from facelib.fdl.values import LuaTable, to_python
+from facelib.fdl.values import LuaTable, LuaValue, to_python
 
 __all__ = ["load", "loads"]
 
@@ -77,10 +77,10 @@ def loads(
     File names in the script resolve relative to ``base_dir`` (none allowed without it).
     """
     if not isinstance(text, str):
-        raise FdlError(f"storyboard text must be a str, got {type(text).__name__}", path=name)
+        raise ParameterError(f"storyboard text must be a str, got {type(text).__name__}")
     folder = None if base_dir is None else Path(base_dir)
     if folder is not None and not folder.is_dir():
-        raise FdlError(f"base_dir {str(base_dir)!r} is not a folder", path=name)
+        raise ParameterError(f"base_dir {str(base_dir)!r} is not a folder")
     return _load(text, name=name, base_dir=folder, seed=seed, file=None, sandbox=sandbox)
 
 
@@ -128,7 +128,7 @@ def _line(text: str, name: str) -> int | None:
     return line_of_name(text, name)
 
 
-def _global(chunk: ChunkResult, key: str) -> Any:
+def _global(chunk: ChunkResult, key: str) -> LuaValue:
     value = chunk.env[key]
     return None if value is None else to_python(value, chunk.lines, path=chunk.path)
 
@@ -246,7 +246,7 @@ def _check_output(output: Path, *, inputs: tuple[Path | None, ...], ctx: Context
                        path=ctx.path, line=line)
 
 
-def _calls(chunk: ChunkResult) -> list[tuple[str, object, int | None, int]]:
+def _calls(chunk: ChunkResult) -> list[tuple[str, LuaValue, int | None, int]]:
     """The storyboard-function calls the sandbox recorded: (function, argument, line,
     number of arguments)."""
     calls = []

@@ -19,7 +19,7 @@ from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.context import Context
 from facelib.fdl.timing import parse_time
-from facelib.fdl.values import LuaTable, lua_kind
+from facelib.fdl.values import LuaTable, LuaValue, lua_kind
 from facelib.mpeg4.tables import fap_table
 
 if TYPE_CHECKING:
@@ -205,19 +205,6 @@ def read_look(
     )
 
 
-def _check_say_values(f: Mapping[str, Any], ctx: Context, line: int | None) -> None:
-    """The types of say's named fields, and the ranges of ``rate`` and ``pitch``."""
-    for key in ("text", "transcript", "audio", "lang", "voice"):
-        if key in f and not isinstance(f[key], str):
-            raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
-    for key, (low, high) in _SAY_RANGES.items():
-        value = f.get(key)
-        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
-                                  or not low <= value <= high):
-            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
-                           path=ctx.path, line=line)
-
-
 def read_say(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
@@ -234,13 +221,16 @@ def read_say(
         return
     t = _table(arg, "say", ctx, line, allowed=fn.fields)
     f = t.fields
-    if len(t.items) > 1 or (t.items and not isinstance(t.items[0], str)):
+    first = t.items[0] if t.items else None
+    if len(t.items) > 1 or (t.items and not isinstance(first, str)):
         raise FdlError(
             "say takes the spoken text first, then named fields (audio = ..., at = ...)",
             path=ctx.path,
             line=line,
         )
-    text = t.items[0] if t.items else f.get("text")
+    strings = {key: _string(f, key, "say", ctx, line)
+               for key in ("text", "transcript", "audio", "lang", "voice")}
+    text = first if isinstance(first, str) else strings["text"]
     if t.items and "text" in f:
         raise FdlError(
             "say: the text is given twice (first value and text =)", path=ctx.path, line=line
@@ -249,7 +239,8 @@ def read_say(
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
-    _check_say_values(f, ctx, line)
+    numbers = {key: _ranged(f, key, low, high, ctx=ctx, line=line)
+               for key, (low, high) in _SAY_RANGES.items()}
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
@@ -257,14 +248,38 @@ def read_say(
         line=line,
         at_ms=_opt_time(f, "at", "say", ctx, line) or 0,
         text=text,
-        transcript=f.get("transcript"),
-        audio=f.get("audio"),
+        transcript=strings["transcript"],
+        audio=strings["audio"],
         visemes=visemes,
-        lang=f.get("lang"),
-        voice=f.get("voice"),
-        rate=float(f.get("rate", 1.0)),
-        pitch=float(f.get("pitch", 50.0)),
+        lang=strings["lang"],
+        voice=strings["voice"],
+        rate=numbers["rate"] if numbers["rate"] is not None else 1.0,
+        pitch=numbers["pitch"] if numbers["pitch"] is not None else 50.0,
     )
+
+
+def _ranged(
+    fields: Mapping[str, LuaValue], key: str, low: float, high: float, *, ctx: Context,
+    line: int | None,
+) -> float | None:
+    """Field ``key`` as a number in ``[low, high]`` (None when absent); FdlError otherwise."""
+    value = fields.get(key)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not low <= value <= high:
+        raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
+                       path=ctx.path, line=line)
+    return float(value)
+
+
+def _string(
+    fields: Mapping[str, LuaValue], key: str, fn: str, ctx: Context, line: int | None
+) -> str | None:
+    """Field ``key`` as a string (None when absent); FdlError if it is something else."""
+    value = fields.get(key)
+    if value is not None and not isinstance(value, str):
+        raise FdlError(f"{fn}: {key} must be a string; got {value!r}", path=ctx.path, line=line)
+    return value
 
 
 def _visemes(
@@ -389,12 +404,11 @@ def read_define_gaze(
     for key, value in t.fields.items():
         if isinstance(value, str | bool | int | float):
             params[key] = value if isinstance(value, str | bool) else float(value)
-        elif (
-            isinstance(value, LuaTable)
-            and not value.fields
-            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value.items)
-        ):
-            params[key] = tuple(float(v) for v in value.items)
+        elif isinstance(value, LuaTable) and not value.fields and len(
+            numbers := [v for v in value.items
+                        if isinstance(v, int | float) and not isinstance(v, bool)]
+        ) == len(value.items):
+            params[key] = tuple(float(v) for v in numbers)
         else:
             raise FdlError(
                 f"define_gaze {{ {name!r} }}: parameter {key} must be a string, number, "

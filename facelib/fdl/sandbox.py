@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from facelib import data
-from facelib.checks import did_you_mean
+from facelib.checks import check_count, check_number, did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.marking import mark_tables
 
@@ -106,15 +106,10 @@ class Sandbox:
         max_instructions: int = DEFAULT_MAX_INSTRUCTIONS,
         max_seconds: float = DEFAULT_MAX_SECONDS,
     ) -> None:
-        if max_memory < 1024 * 1024:
-            raise FdlError(f"max_memory={max_memory} is below the 1 MiB a Lua state needs")
-        if max_instructions < 1000:
-            raise FdlError(f"max_instructions={max_instructions} is below 1000")
-        if not (isinstance(max_seconds, int | float) and 0 < max_seconds <= 3600):
-            raise FdlError(f"max_seconds={max_seconds!r} must be in (0, 3600]")
-        self.max_memory = int(max_memory)
-        self.max_instructions = int(max_instructions)
-        self.max_seconds = float(max_seconds)
+        self.max_memory = check_count("max_memory", max_memory, low=1024 * 1024)
+        self.max_instructions = check_count("max_instructions", max_instructions, low=1000)
+        self.max_seconds = check_number("max_seconds", max_seconds, low=0.0, high=3600.0,
+                                        low_open=True)
         self.printed: list[str] = []
         self._start()
 

@@ -149,12 +149,14 @@ def _entry(
             path=ctx.path,
             line=where,
         )
+    between: list[str | float] = []
     for arg in args:
         if isinstance(arg, bool) or not isinstance(arg, str | int | float):
             raise FdlError(
                 f"{label} value {arg!r} must be a string or a number", path=ctx.path, line=where
             )
-    return name, tuple(a if isinstance(a, str) else float(a) for a in args), float(frames)
+        between.append(arg if isinstance(arg, str) else float(arg))
+    return name, tuple(between), float(frames)
 
 
 def _show(value: object) -> str:

@@ -13,7 +13,7 @@ from typing import Any
 
 from facelib.errors import FdlError
 
-__all__ = ["LuaTable", "Opaque", "to_python"]
+__all__ = ["LuaTable", "LuaValue", "Opaque", "to_python"]
 
 _MAX_DEPTH = 32
 _MAX_NODES = 1_000_000
@@ -33,9 +33,13 @@ class LuaTable:
     """A Lua table: ``items`` holds keys 1..n in order, ``fields`` the string keys,
     ``line`` the line of its constructor (None when no constructor made it)."""
 
-    items: tuple[Any, ...] = ()
-    fields: dict[str, Any] = field(default_factory=dict)
+    items: tuple[LuaValue, ...] = ()
+    fields: dict[str, LuaValue] = field(default_factory=dict)
     line: int | None = None
+
+
+LuaValue = str | int | float | bool | LuaTable | Opaque | None
+"""A Lua value copied into Python by :func:`to_python`."""
 
 
 def lua_kind(value: Any) -> str:
@@ -55,7 +59,7 @@ def lua_kind(value: Any) -> str:
     return type(value).__name__
 
 
-def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> Any:
+def to_python(value: Any, lines: Any, *, path: str, line: int | None = None) -> LuaValue:
     """Copy ``value`` (a lupa value) into plain Python.
 
     ``lines`` is the sandbox's table -> line map. Tables nested deeper than 32 levels
@@ -83,7 +87,7 @@ class _Copier:
     def fail(self, message: str, line: int | None) -> FdlError:
         return FdlError(message, path=self.path, line=line)
 
-    def value(self, v: Any, depth: int, where: int | None) -> Any:
+    def value(self, v: Any, depth: int, where: int | None) -> LuaValue:
         self.values += 1
         if self.values > _MAX_NODES:
             raise self.fail(f"script left more than {_MAX_NODES} values", where)
@@ -107,8 +111,8 @@ class _Copier:
         here = int(own) if isinstance(own, int) else where
         if depth >= _MAX_DEPTH:
             raise self.fail(f"tables nested deeper than {_MAX_DEPTH} levels (a cycle?)", here)
-        numbered: dict[int, Any] = {}
-        named: dict[str, Any] = {}
+        numbered: dict[int, LuaValue] = {}
+        named: dict[str, LuaValue] = {}
         for key, item in v.items():
             if isinstance(key, bool) or not isinstance(key, int | str):
                 raise self.fail(f"table key {key!r} is neither a name nor a position", here)

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from facelib.checks import check_count, check_fps, check_number, check_seed
+from facelib.checks import check_count, check_fps, check_items, check_number, check_seed
 from facelib.cues import GazeCue
 from facelib.errors import ParameterError
 from facelib.gaze.behaviours import BoundBehaviour, bind_behaviour, merge_behaviours
@@ -123,6 +123,7 @@ def animate(
     ParameterError: bad fps, n_frames or speaking.
     """
     fps, n_frames, seed = _checked(fps, n_frames, seed)
+    cues = check_items("cues", cues, GazeCue)
     library = merge_behaviours(behaviours)
     bound = [
         (c, bind_behaviour(c.behaviour, c.args, library=library, origin=c.origin))

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from facelib.atomic import write_text_atomic
+from facelib.checks import check_kind
 from facelib.errors import FacelibWarning, FapFormatError, ParameterError
 from facelib.mpeg4.stream import (
     EXPRESSION_FIELDS,
@@ -423,6 +424,7 @@ def write_fap(
 def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "facelib") -> str:
     """The text of a ``.fap`` file holding ``stream`` (see :func:`write_fap` for
     ``dialect``); ``name`` goes into the header, spaces becoming underscores."""
+    stream = check_kind("stream", stream, FapStream)
     if dialect not in DIALECTS:
         raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():

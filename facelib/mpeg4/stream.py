@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facelib.checks import check_fps
+from facelib.checks import check_fps, check_number
 from facelib.errors import ParameterError
 from facelib.mpeg4.tables import N_FAPS
 
@@ -155,6 +155,8 @@ class FapStream:
 
     def between(self, start: float = 0.0, stop: float | None = None) -> FapStream:
         """The frames shown in ``[start, stop)`` seconds."""
+        start = check_number("start", start, low=0.0)
+        stop = None if stop is None else check_number("stop", stop, low=start)
         first = int(np.ceil(start * self.fps - 1e-9))
         last = self.n_frames if stop is None else int(np.ceil(stop * self.fps - 1e-9))
         if start < 0 or last < first:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import warnings
 
-from facelib.checks import check_number
+from facelib.checks import check_kind, check_number
 from facelib.errors import MissingExtraError, PronunciationWarning, SpeechError
 from facelib.speech.pronounce import letter_to_sound, pronounce, tokenize
 from facelib.speech.tables import DurationRules, duration_rules, phone_durations
@@ -29,6 +29,7 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
     """Phones and words of ``text`` spoken at ``rate`` (1.0 is about 160 words per
     minute; 2.0 twice as fast), from the duration model (``phone_durations.csv``, pauses at
     punctuation from ``pauses.csv``). Times in ms from 0; ``source="durations"``."""
+    text = check_kind("text", text, str)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     pauses = pause_table()
     rules = duration_rules()

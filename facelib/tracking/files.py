@@ -170,7 +170,10 @@ def _read_json(path: Path, text: str) -> LandmarkFile:
 
 
 def _read_pts_file(path: Path) -> np.ndarray:
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TrackingError(f"cannot read it: {exc}", path=path) from exc
     match = re.search(r"\{(.*)\}", text, re.DOTALL)
     count = re.search(r"n_points\s*:\s*(\d+)", text)
     if match is None or count is None:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.checks import check_fps, check_number
+from facelib.checks import check_fps, check_kind, check_number
 from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
 from facelib.errors import MissingExtraError, SpeechError, SpeechWarning
 from facelib.mpeg4.track import FapTrack
@@ -177,6 +177,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     ``rate`` multiplies the speech's own speaking rate; ``language`` is the storyboard's.
     Speech longer than ``max_frames`` raises SpeechError before the curves are computed.
     """
+    speech = check_kind("speech", speech, SpeechSpec)
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     own, audio = _spoken(speech, rate=rate, language=language)

@@ -60,3 +60,16 @@ def test_did_you_mean_is_the_only_one():
     users = [p.relative_to(package).as_posix() for p in package.rglob("*.py")
              if "difflib" in p.read_text(encoding="utf-8")]
     assert users == ["checks.py"]
+
+
+def test_check_kind_and_items():
+    from facelib.checks import check_items, check_kind
+
+    assert check_kind("x", 3, int) == 3
+    with pytest.raises(ParameterError, match="x must be a str, got int 3"):
+        check_kind("x", 3, str)
+    assert check_items("xs", (1, 2), int) == [1, 2]
+    with pytest.raises(ParameterError, match=r"xs\[1\] must be a int, got str"):
+        check_items("xs", [1, "a"], int)
+    with pytest.raises(ParameterError, match="xs must be a sequence of int, got str"):
+        check_items("xs", "12", int)

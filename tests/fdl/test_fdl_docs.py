@@ -38,3 +38,14 @@ def test_doc_modern_example_values():
     assert (default.start_ms, default.duration_ms) == (3000, 3000)
     assert joy.origin == ("hello.fdl", 7)
     assert default.origin == ("hello.fdl", 12)
+
+
+def test_doc_definitions_example_animates():
+    """The define_* example is not only loaded but run through the generators, which
+    check expression names and eye-behaviour parameters."""
+    from facelib import animate
+
+    text = next(e for e in EXAMPLES if "define_gaze" in e)
+    animation = animate(fdl.loads(text, name="defs.fdl", base_dir=DATA))
+    assert animation.faps.n_frames > 0
+    assert animation.gaze_events

@@ -52,3 +52,21 @@ def test_a_very_close_global_is_an_error_and_far_ones_pass_silently():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         fdl.loads("beat = 0.5\nshow { 'joy', dur = 2 * beat }")
+
+
+def test_docs_describe_every_function_and_field():
+    from pathlib import Path
+
+    doc = (Path(__file__).parents[2] / "docs" / "fdl.md").read_text(encoding="utf-8")
+    for spec in functions.FUNCTIONS.values():
+        assert f"`{spec.name}" in doc or f"{spec.name} {{" in doc, spec.name
+        for field in spec.fields or ():
+            assert f"`{field}" in doc or f"{field} =" in doc, (spec.name, field)
+    for setting in functions.SETTINGS:
+        assert f"`{setting}`" in doc, setting
+
+
+def test_fields_come_in_name_order_whatever_the_lua_state():
+    text = 'define_gaze { "n", zeta = 1, alpha = 2, mid = 3, beta = 4 }'
+    orders = {tuple(fdl.loads(text, sandbox=Sandbox()).gaze_defs["n"]) for _ in range(4)}
+    assert orders == {("alpha", "beta", "mid", "zeta")}
