@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -101,11 +102,13 @@ def test_contact_sheet_shows_each_deformer(tmp_path: Path) -> None:
 
 @pytest.mark.render
 def test_every_deformer_keeps_the_rendered_lips_in_place() -> None:
-    """Each deformer on the lips, lip poses without the jaw: pixels change around the mouth
-    and nowhere else (joy also lifts the cheeks a little). A deformer that tears the lips
-    apart or throws vertices away changes thousands of pixels outside (checked by hand with
-    random weights: over 6,000 of 9,216). It does not see small steps at the lip corners;
-    the flipped-triangle counts and the roughness do."""
+    """Each deformer on the lips, lip poses without the jaw: outside the mouth, pixels change
+    no more than with the head's own deformers (the learned fields move the cheeks with the
+    lip corners; that motion is the same whatever deforms the lips), and they do change
+    around the mouth. A deformer that tears the lips apart or throws vertices away changes
+    thousands of pixels outside (checked by hand with random weights: over 6,000 of 9,216).
+    It does not see small steps at the lip corners; the flipped-triangle counts and the
+    roughness do."""
     from facelib.engine import load_face
     from facelib.evaluate import DEFORMERS
     from facelib.rendering.scene import FaceRenderer
@@ -113,9 +116,11 @@ def test_every_deformer_keeps_the_rendered_lips_in_place() -> None:
     poses = {p.name: np.array(p.frames[-1]) for p in evaluation_poses(("viseme", "expression"))}
     size = 96
     rows, cols = np.mgrid[:size, :size]
-    for name in DEFORMERS:
-        face = load_face(deformers={"lips": name})
+
+    def changes(face: Any) -> dict[str, tuple[int, int]]:
+        """Pose -> (pixels changed outside the mouth box, inside it)."""
         lips = np.unique(np.concatenate([r.vertices for r in face.regions if r.group == "lips"]))
+        out = {}
         with FaceRenderer(face, width=size, height=size) as renderer:
             xy = renderer.project(face.vertices[lips])
             lo, hi = xy.min(axis=0), xy.max(axis=0)
@@ -127,6 +132,12 @@ def test_every_deformer_keeps_the_rendered_lips_in_place() -> None:
                 values[[2, 13, 14]] = 0  # no jaw: only the lips (and cheeks) move
                 image = renderer.frame(face.deform_frame(values)).astype(int)
                 changed = np.abs(image - rest).sum(axis=2) > 30
-                assert (changed & outside).sum() <= 5, (name, pose)
-                if name != "raised_cosine":  # it barely moves the lips (docs/deformers.md)
-                    assert (changed & ~outside).sum() >= 10, (name, pose)
+                out[pose] = (int((changed & outside).sum()), int((changed & ~outside).sum()))
+        return out
+
+    baseline = changes(load_face())
+    for name in DEFORMERS:
+        for pose, (outside, inside) in changes(load_face(deformers={"lips": name})).items():
+            assert outside <= baseline[pose][0] + 5, (name, pose, outside, baseline[pose])
+            if name != "raised_cosine":  # it barely moves the lips (docs/deformers.md)
+                assert inside >= 10, (name, pose)

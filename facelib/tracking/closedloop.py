@@ -87,8 +87,9 @@ def with_neutral_lead(stream: FapStream, frames: int) -> FapStream:
 
 def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: int = 8,
                 width: int = 640, height: int = 480, keep_frames: bool = False,
-                **options: Any) -> ClosedLoop:
-    """Render ``face`` (default head) driven by ``stream`` after ``neutral_frames`` neutral
+                framing: str = "head", **options: Any) -> ClosedLoop:
+    """Render ``face`` (default head, framed as ``framing``: the whole head by default, as a
+    webcam sees a person) driven by ``stream`` after ``neutral_frames`` neutral
     frames, track it with MediaPipe and recover the FAPs (``options`` go to
     :func:`~facelib.tracking.faps.measure_faps`). The lead frames are cut from the result.
     """
@@ -96,7 +97,7 @@ def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: 
     full = with_neutral_lead(stream, neutral_frames)
     rendered: list[np.ndarray] = []
     points = np.full((full.n_frames, N_LANDMARKS, 3), np.nan)
-    with FaceRenderer(face, width=width, height=height) as renderer, \
+    with FaceRenderer(face, width=width, height=height, framing=framing) as renderer, \
             FaceMeshTracker(video=True, max_faces=1) as tracker:
         for i, image in enumerate(iter_frames(renderer, face, full)):
             found = tracker.detect(image)

@@ -46,7 +46,7 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
     values = np.zeros(N_FAPS, np.float32)
     values[2] = check_number("open_jaw", open_jaw, low=0)
     vertices = np.asarray(face.deform(FapStream(25.0, values[None]))[0], np.float64)
-    with FaceRenderer(face, width=width, height=height) as renderer:
+    with FaceRenderer(face, width=width, height=height, framing="head") as renderer:
         image = renderer.frame(vertices)
         projected = renderer.project(vertices)
         camera = np.linalg.inv(renderer.camera_pose)

@@ -53,3 +53,4 @@ def test_no_face_and_bad_images():
         detect_landmarks(blank.astype(np.float32))
     with pytest.raises(ParameterError, match="shape"):
         detect_landmarks(blank[..., 0])
+
