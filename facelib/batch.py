@@ -12,15 +12,19 @@ import multiprocessing
 import os
 import signal
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 from facelib.checks import check_count
 from facelib.errors import FacelibError, ParameterError
 from facelib.progress import ProgressCallback, progress_callback
 
-__all__ = ["BatchResult", "RenderJob", "default_jobs", "render_batch", "render_job"]
+T = TypeVar("T")
+R = TypeVar("R")
+
+__all__ = ["BatchResult", "RenderJob", "default_jobs", "render_batch", "render_job", "spawn_map"]
 
 BATCH_SUFFIXES = (".mp4", ".gif")
 
@@ -141,21 +145,34 @@ def render_batch(
     n_jobs = min(n_jobs, max(len(planned), 1))
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     report = progress_callback(progress, "batch", unit="files")
-    results: dict[int, BatchResult] = {}
-    context = multiprocessing.get_context("spawn")
-    pool = context.Pool(n_jobs, initializer=_raise_on_sigterm, maxtasksperchild=8)
+    done = spawn_map(_indexed, list(enumerate(planned)), jobs=n_jobs, report=report,
+                     max_tasks_per_child=8)
+    results = dict(done)
+    return tuple(results[i] for i in range(len(planned)))
+
+
+def spawn_map(function: Callable[[T], R], tasks: Sequence[T], *, jobs: int,
+              report: ProgressCallback | None = None,
+              max_tasks_per_child: int | None = None) -> list[R]:
+    """``function`` over ``tasks`` on ``jobs`` spawned worker processes; the results in the
+    order they finish. ``report(done, len(tasks))`` follows each one. Ctrl-C, SIGTERM or any
+    error terminates the workers, whose SIGTERM raises SystemExit so that their atomic
+    writers remove their temporary files."""
+    results: list[R] = []
+    pool = multiprocessing.get_context("spawn").Pool(
+        jobs, initializer=_raise_on_sigterm, maxtasksperchild=max_tasks_per_child)
     try:
-        for index, result in pool.imap_unordered(_indexed, list(enumerate(planned))):
-            results[index] = result
+        for result in pool.imap_unordered(function, tasks):
+            results.append(result)
             if report is not None:
-                report(len(results), len(planned))
+                report(len(results), len(tasks))
         pool.close()
     except BaseException:
         pool.terminate()
         raise
     finally:
         pool.join()
-    return tuple(results[i] for i in range(len(planned)))
+    return results
 
 
 def _indexed(item: tuple[int, RenderJob]) -> tuple[int, BatchResult]:

@@ -419,26 +419,11 @@ def _environment(values: Mapping[str, str]) -> Iterator[None]:
 def _run_local(spec: DatasetSpec, todo: Sequence[int], out_dir: str, jobs: int,
                report: ProgressCallback | None) -> list[tuple[int, str, str | None]]:
     """The clips ``todo`` on ``jobs`` spawned worker processes, one BLAS thread each."""
-    import multiprocessing
+    from facelib.batch import spawn_map
 
-    from facelib.batch import _raise_on_sigterm
-
-    results: list[tuple[int, str, str | None]] = []
-    with _environment(_ONE_THREAD):
-        pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_raise_on_sigterm)
-    try:
-        tasks = [(spec, i, out_dir) for i in todo]
-        for result in pool.imap_unordered(_star_clip_task, tasks):
-            results.append(result)
-            if report is not None:
-                report(len(results), len(todo))
-        pool.close()
-    except BaseException:
-        pool.terminate()
-        raise
-    finally:
-        pool.join()
-    return results
+    with _environment(_ONE_THREAD):  # read by the workers as they start
+        return spawn_map(_star_clip_task, [(spec, i, out_dir) for i in todo], jobs=jobs,
+                         report=report)
 
 
 def _star_clip_task(args: tuple[DatasetSpec, int, str]) -> tuple[int, str, str | None]:
