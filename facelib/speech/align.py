@@ -23,7 +23,7 @@ from facelib.errors import ParameterError, PronunciationWarning, SpeechError, Sp
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.pronounce import model_dir, pronounce, tokenize
 from facelib.speech.tables import alignment_settings, phone_durations
-from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Span, append_span, cover
 
 __all__ = ["align"]
 
@@ -139,13 +139,13 @@ def _forced_in_pieces(
         p, w, trouble, oov = _forced(to_pcm16(piece, pad_ms=pad), span.label, end - start,
                                      where, decoders)
         for s in p:
-            _append(phones, s.label, s.start_ms + start, s.end_ms + start)
+            append_span(phones, s.label, s.start_ms + start, s.end_ms + start)
         for s in w:
-            _append(words, s.label, s.start_ms + start, s.end_ms + start)
+            append_span(words, s.label, s.start_ms + start, s.end_ms + start)
         problems += trouble
         guessed += [g for g in oov if g not in guessed]
     decoders.clear()
-    return _cover(phones, duration_ms), _cover(words, duration_ms), problems, guessed
+    return cover(phones, duration_ms), cover(words, duration_ms), problems, guessed
 
 
 def tokenize_words(text: str) -> list[str]:
@@ -221,17 +221,17 @@ def _forced_with(
         is_sil = name in _NOISE
         start = to_ms(word_start)
         end = to_ms(word_phones[-1][1] + word_phones[-1][2]) if word_phones else start
-        _append(word_spans, SILENCE if is_sil else name, start, end)
+        append_span(word_spans, SILENCE if is_sil else name, start, end)
         spans = [(SILENCE if (is_sil or label in _NOISE) else label, to_ms(p_start),
                   to_ms(p_start + p_dur)) for label, p_start, p_dur, _ in word_phones]
         for label, p_start, p_end in _shift_boundaries(spans, settings):
-            _append(phone_spans, label, p_start, p_end)
+            append_span(phone_spans, label, p_start, p_end)
         if not is_sil:
             final = k + 1 == n_entries or entries[k + 1][0] in _NOISE
             problems += _check_word(name, word_phones, settings, name in guessed, final=final)
         else:
             problems += _check_pause(word_spans, word_phones, settings)
-    return (_cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems,
+    return (cover(phone_spans, duration_ms), cover(word_spans, duration_ms), problems,
             guessed)
 
 
@@ -308,10 +308,10 @@ def _phone_loop(pcm: bytes, duration_ms: int) -> tuple[Span, ...]:
     spans: list[Span] = []
     for seg in decoder.seg():
         label = SILENCE if seg.word in _NOISE else seg.word
-        _append(spans, label, to_ms(seg.start_frame), to_ms(seg.end_frame + 1))
+        append_span(spans, label, to_ms(seg.start_frame), to_ms(seg.end_frame + 1))
     if not spans or all(s.label == SILENCE for s in spans):
         raise SpeechError("no speech recognised in the audio")
-    return _cover(spans, duration_ms)
+    return cover(spans, duration_ms)
 
 
 def _frame_to_ms(duration_ms: int) -> Callable[[int], int]:
@@ -324,29 +324,3 @@ def _frame_to_ms(duration_ms: int) -> Callable[[int], int]:
 
     return to_ms
 
-
-def _append(spans: list[Span], label: str, start: int, end: int) -> None:
-    """Append a span, dropping empty ones and joining consecutive silences."""
-    if spans:
-        start = max(start, spans[-1].end_ms)
-    if end <= start:
-        return
-    if spans and label == SILENCE and spans[-1].label == SILENCE:
-        spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
-    elif spans and spans[-1].end_ms < start:
-        _append(spans, SILENCE, spans[-1].end_ms, start)
-        _append(spans, label, start, end)
-    else:
-        spans.append(Span(label, start, end))
-
-
-def _cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
-    """The spans with silence filling the time before the first and after the last."""
-    out: list[Span] = []
-    if spans and spans[0].start_ms > 0:
-        out.append(Span(SILENCE, 0, spans[0].start_ms))
-    for span in spans:
-        _append(out, span.label, span.start_ms, span.end_ms)
-    if out and out[-1].end_ms < duration_ms:
-        _append(out, SILENCE, out[-1].end_ms, duration_ms)
-    return tuple(out)

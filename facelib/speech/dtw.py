@@ -22,7 +22,7 @@ import numpy as np
 from facelib.errors import MissingExtraError, SpeechError
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.synth import DEFAULT_LANGUAGE, Synthesis, synthesize_many, voice_for
-from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Span, append_span, cover
 
 __all__ = ["HOP_MS", "align_dtw", "mfcc_features", "sentence_spans"]
 
@@ -153,10 +153,11 @@ def align_dtw(
     for _, syn, to_rec_ms in _warped(samples, text, lang=lang, voice=voice,
                                        by_sentence=by_sentence, where=where):
         for span in syn.timeline.phones:
-            _extend(phones, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+            append_span(phones, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
         for span in syn.timeline.words:
-            _extend(words, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
-    return PhoneTimeline(_cover(phones, duration_ms), _cover(words, duration_ms), "dtw",
+            append_span(words, span.label, to_rec_ms(span.start_ms), to_rec_ms(span.end_ms))
+    return PhoneTimeline(cover(_clipped(phones, duration_ms), duration_ms),
+                         cover(_clipped(words, duration_ms), duration_ms), "dtw",
                          duration_ms, alphabet="ipa")
 
 
@@ -215,27 +216,7 @@ def _warped(
         cursor = offset + int(np.ceil(mapped[-1]))
 
 
-def _extend(spans: list[Span], label: str, start: int, end: int) -> None:
-    """Append ``[start, end)`` after the spans so far (clipped to begin where they end),
-    joining silences and filling gaps with silence; empty spans are dropped."""
-    if spans:
-        start = max(start, spans[-1].end_ms)
-        if spans[-1].end_ms < start:
-            _extend(spans, SILENCE, spans[-1].end_ms, start)
-    if end <= start:
-        return
-    if spans and label == SILENCE and spans[-1].label == SILENCE:
-        spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
-    else:
-        spans.append(Span(label, start, end))
-
-
-def _cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
-    out: list[Span] = []
-    if spans and spans[0].start_ms > 0:
-        out.append(Span(SILENCE, 0, spans[0].start_ms))
-    for s in spans:
-        _extend(out, s.label, min(s.start_ms, duration_ms), min(s.end_ms, duration_ms))
-    if out and out[-1].end_ms < duration_ms:
-        _extend(out, SILENCE, out[-1].end_ms, duration_ms)
-    return tuple(out)
+def _clipped(spans: list[Span], duration_ms: int) -> list[Span]:
+    """The spans cut at ``duration_ms`` (the warp may reach a little past the recording)."""
+    return [Span(s.label, min(s.start_ms, duration_ms), min(s.end_ms, duration_ms))
+            for s in spans if s.start_ms < duration_ms]

@@ -27,7 +27,7 @@ from facelib.speech.espeak import (
     synth_fresh,
 )
 from facelib.speech.normalize import spell_numbers
-from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
+from facelib.speech.timeline import SILENCE, PhoneTimeline, Span, append_span, cover
 
 __all__ = ["DEFAULT_LANGUAGE", "Language", "Synthesis", "languages", "list_voices",
            "synthesize", "synthesize_many", "voice_for"]
@@ -161,7 +161,7 @@ def events_to_timeline(
     bounds = [*(e.sample for e in phone_events), n_samples]
     phones: list[Span] = []
     for e, end in zip(phone_events, bounds[1:], strict=True):
-        _add(phones, _STRESS.sub("", e.name) or SILENCE, ms(e.sample), ms(end))
+        append_span(phones, _STRESS.sub("", e.name) or SILENCE, ms(e.sample), ms(end))
     duration = ms(n_samples)
     phones = _covered(phones, duration)
     starts = [p.start_ms for p in phones]
@@ -178,34 +178,13 @@ def events_to_timeline(
         if words and words[-1].start_ms == start:  # espeak expanded one token to many
             continue
         label = text[w.text_position - 1:w.text_position - 1 + w.length].strip().lower()
-        _add(words, label or "?", start, end)
+        append_span(words, label or "?", start, end)
     return PhoneTimeline(tuple(phones), tuple(_covered(words, duration)), "synthesis",
                          duration, alphabet="ipa")
 
 
-def _add(spans: list[Span], label: str, start: int, end: int) -> None:
-    """Append ``[start, end)`` (dropping empty spans, joining silences, filling gaps)."""
-    if spans:
-        start = max(start, spans[-1].end_ms)
-    if end <= start:
-        return
-    if spans and spans[-1].end_ms < start:
-        _add(spans, SILENCE, spans[-1].end_ms, start)
-    if spans and label == SILENCE and spans[-1].label == SILENCE:
-        spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
-    else:
-        spans.append(Span(label, start, end))
-
-
 def _covered(spans: list[Span], duration_ms: int) -> list[Span]:
-    """``spans`` with silence before the first and after the last, up to ``duration_ms``."""
-    out: list[Span] = []
-    if spans and spans[0].start_ms > 0:
-        out.append(Span(SILENCE, 0, spans[0].start_ms))
-    for s in spans:
-        _add(out, s.label, s.start_ms, s.end_ms)
-    if not out:
-        return [Span(SILENCE, 0, duration_ms)] if duration_ms else []
-    if out[-1].end_ms < duration_ms:
-        _add(out, SILENCE, out[-1].end_ms, duration_ms)
-    return out
+    """``spans`` with silence before the first and after the last, up to ``duration_ms``
+    (all silence when there are none)."""
+    out = list(cover(spans, duration_ms))
+    return out or ([Span(SILENCE, 0, duration_ms)] if duration_ms else [])

@@ -65,3 +65,32 @@ def check_interval(label: str, start_ms: int, end_ms: int) -> None:
         )
     if end_ms < start_ms:
         raise ParameterError(f"span {label!r} ends ({end_ms} ms) before it starts ({start_ms} ms)")
+
+
+def append_span(spans: list[Span], label: str, start: int, end: int) -> None:
+    """Append ``[start, end)`` to ``spans`` (in place), clipped to begin where they end:
+    empty spans are dropped, consecutive silences joined and gaps filled with silence."""
+    if spans:
+        start = max(start, spans[-1].end_ms)
+    if end <= start:
+        return
+    if spans and label == SILENCE and spans[-1].label == SILENCE:
+        spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
+    elif spans and spans[-1].end_ms < start:
+        append_span(spans, SILENCE, spans[-1].end_ms, start)
+        append_span(spans, label, start, end)
+    else:
+        spans.append(Span(label, start, end))
+
+
+def cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
+    """``spans`` with silence filling the time before the first and after the last, up to
+    ``duration_ms``."""
+    out: list[Span] = []
+    if spans and spans[0].start_ms > 0:
+        out.append(Span(SILENCE, 0, spans[0].start_ms))
+    for span in spans:
+        append_span(out, span.label, span.start_ms, span.end_ms)
+    if out and out[-1].end_ms < duration_ms:
+        append_span(out, SILENCE, out[-1].end_ms, duration_ms)
+    return tuple(out)
