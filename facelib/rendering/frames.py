@@ -151,11 +151,19 @@ def render(
                           framing=framing) as renderer:
             frames = iter_frames(renderer, face, stream, progress=progress)
             if out is None:
-                return np.stack(list(frames)) if stream.n_frames else np.empty(
-                    (0, renderer.height, renderer.width, 3), np.uint8)
+                return _collect(frames, stream.n_frames, renderer.height, renderer.width)
             mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
             return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
                           audio_offset=offset)
+
+
+def _collect(frames: Iterator[np.ndarray], n_frames: int, height: int, width: int
+             ) -> np.ndarray:
+    """``(n_frames, height, width, 3) uint8``: the frames in one preallocated array."""
+    result = np.empty((n_frames, height, width, 3), np.uint8)
+    for i, image in enumerate(frames):
+        result[i] = image
+    return result
 
 
 def _one_png(
