@@ -4,15 +4,27 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 EXTRAS ?= all
 
-.PHONY: demo test setup lint bench clean
+.PHONY: demo test setup lint bench clean web
+WEB := facelib/export/web
 
 demo: $(VENV)/.installed
 	$(BIN)/facelib render examples/hello/hello.fdl -o out/hello.mp4 --fap out/hello.fap
 
-test: lint
+test: lint $(WEB)/dist/player.js
 	$(BIN)/python -m pytest
 
-setup: $(VENV)/.installed
+setup: $(VENV)/.installed $(WEB)/dist/player.js
+
+# The web player: npm packages from the lockfile (three.js, esbuild, puppeteer-core and
+# gltf-validator for the tests), then three.js and the player bundled into one file.
+web: $(WEB)/dist/player.js
+
+$(WEB)/node_modules/.installed: $(WEB)/package.json $(WEB)/package-lock.json
+	cd $(WEB) && npm ci --no-audit --no-fund
+	touch $@
+
+$(WEB)/dist/player.js: $(WEB)/node_modules/.installed $(WEB)/src/player.js
+	cd $(WEB) && npm run --silent build
 
 # Debian packages first (tools/debian-deps installs them as root, otherwise prints the
 # apt-get command), then a virtualenv with the package and its extras.
@@ -30,8 +42,9 @@ lint: $(VENV)/.installed
 
 # Figures, not pass/fail: each benchmark prints what it measured.
 bench: $(VENV)/.installed
-	for b in engine_deform engine_setup render_speed gaze_simulate fdl_sandbox visemes_align_accuracy; do \
+	for b in engine_deform engine_setup render_speed gaze_simulate fdl_sandbox \
+		visemes_align_accuracy export_speed; do \
 		PYTHONPATH=. $(BIN)/python benchmarks/$$b.py || exit 1; done
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache $(WEB)/node_modules $(WEB)/dist

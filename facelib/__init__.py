@@ -42,14 +42,19 @@ _LAZY = {
     "save_png": "facelib.rendering.frames",
     "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
+    "export_gltf": "facelib.export",
+    "export_html": "facelib.export",
+    "export_arkit": "facelib.export",
+    "import_arkit": "facelib.export",
+    "to_arkit": "facelib.export",
+    "from_arkit": "facelib.export",
     "setup_face": "facelib.engine.setup",
     "write_face": "facelib.engine.writer",
 }
 
 
 def __getattr__(name: str) -> Any:
-    """Rendering, the viewer, plotting and face set-up import OpenGL, matplotlib or trimesh:
-    load them on use."""
+    """Rendering, the viewer, plotting, the exports and face set-up load on first use."""
     if name in _LAZY:
         import importlib
 
@@ -77,11 +82,16 @@ __all__ = [
     "SpeechWarning",
     "__version__",
     "animate",
+    "export_arkit",
+    "export_gltf",
+    "export_html",
     "expressions",
     "fap",
     "fdl",
     "feature_point",
+    "from_arkit",
     "gaze",
+    "import_arkit",
     "load_face",
     "mpeg4",
     "plot_curves",
@@ -92,6 +102,7 @@ __all__ = [
     "save_png",
     "setup_face",
     "sync",
+    "to_arkit",
     "view",
     "visemes",
     "write_face",

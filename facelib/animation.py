@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -14,16 +15,17 @@ import numpy as np
 from facelib import expressions, gaze, visemes
 from facelib.checks import check_seed
 from facelib.cues import MAX_FRAMES, Storyboard
-from facelib.errors import ParameterError
+from facelib.errors import FacelibError, ParameterError
 from facelib.fdl import load
 from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
+from facelib.progress import ProgressCallback, progress_callback
 from facelib.sync import SyncRules, combine
 from facelib.visemes.animate import VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
 
-__all__ = ["Animation", "animate", "run_fdl"]
+__all__ = ["Animation", "animate", "definition_line", "run_fdl"]
 
 
 @dataclass(frozen=True)
@@ -51,10 +53,24 @@ class Animation:
     def __post_init__(self) -> None:
         object.__setattr__(self, "tracks", MappingProxyType(dict(self.tracks)))
 
+    def __repr__(self) -> str:
+        """One line: where it came from, its length and parts, never the arrays."""
+        source = self.storyboard.path.name if self.storyboard.path else "<storyboard>"
+        audio = f", audio={self.audio.name!r}" if self.audio is not None else ""
+        return (f"Animation({source!r}, frames={self.faps.n_frames}, fps={self.faps.fps:g}, "
+                f"duration={self.faps.duration:.3f}s, "
+                f"expressions={len(self.storyboard.expressions)}, "
+                f"gaze={len(self.storyboard.gaze)}, gaze_events={len(self.gaze_events)}"
+                f"{audio})")
+
+
+_STAGES = 4  # speech, expressions, gaze, synchronizer: the units of animate's progress
+
 
 def animate(
     storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
     max_frames: int = MAX_FRAMES,
+    progress: bool | ProgressCallback | None = None,
 ) -> Animation:
     """Run the generators of a storyboard and resolve their conflicts.
 
@@ -63,8 +79,29 @@ def animate(
     The stream lasts as long as the longest track: the speech, or the last cue including a
     frame at its very end. ``max_frames`` bounds its length (default
     :data:`facelib.cues.MAX_FRAMES`); a longer storyboard raises ParameterError before
-    anything is computed.
+    anything is computed. ``progress`` (see :mod:`facelib.progress`) is called after each
+    of the four stages (speech, expressions, gaze, synchronizer) as ``progress(done, 4)``.
+    An error of a generator that names no file is raised again naming the storyboard (and
+    the line of the definition it concerns, where one can be found).
     """
+    try:
+        return _animate(storyboard, seed=seed, rules=rules, max_frames=max_frames,
+                        report=progress_callback(progress, "animating", unit="stages"))
+    except FacelibError as exc:
+        if exc.path is not None or storyboard.path is None:
+            raise
+        raise type(exc)(exc.message, path=storyboard.path,
+                        line=definition_line(storyboard.path, exc.message)) from exc
+
+
+def _animate(
+    storyboard: Storyboard, *, seed: int | None, rules: SyncRules | None, max_frames: int,
+    report: ProgressCallback | None,
+) -> Animation:
+    def step(done: int) -> None:
+        if report is not None:
+            report(done, _STAGES)
+
     if seed is not None:
         storyboard = replace(storyboard, seed=check_seed(seed))
     rules = rules or SyncRules.load()
@@ -85,6 +122,7 @@ def animate(
     if speech is not None:
         viseme_track = _with_importance(speech, rules).padded(n_frames)
         speaking[: speech.speaking.size] = speech.speaking[:n_frames]
+    step(1)
     expression_track = expressions.animate(
         storyboard.expressions, fps=fps, n_frames=n_frames,
         library=expressions.default_library().with_defs(
@@ -92,11 +130,14 @@ def animate(
         ),
         importance=rules.expression_importance,
     )
+    step(2)
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
                         behaviours=storyboard.gaze_defs, speaking=speaking)
+    step(3)
     stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
                      blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=speaking,
                      rules=rules, seed=storyboard.seed)
+    step(4)
     return Animation(
         faps=stream,
         audio=storyboard.speech.audio if storyboard.speech else None,
@@ -122,6 +163,32 @@ def _with_importance(speech: VisemeAnimation, rules: SyncRules) -> FapTrack:
     return FapTrack(track.fps, track.values, track.weight * factor[:, None])
 
 
-def run_fdl(path: str | os.PathLike[str], *, seed: int | None = None) -> Animation:
-    """Load the storyboard at ``path`` and animate it (see :func:`animate`)."""
-    return animate(load(Path(path), seed=seed), seed=seed)
+def run_fdl(path: str | os.PathLike[str], *, seed: int | None = None,
+            progress: bool | ProgressCallback | None = None) -> Animation:
+    """Load the storyboard at ``path`` and animate it (see :func:`animate`; ``progress``
+    is called after each of animate's four stages)."""
+    return animate(load(Path(path), seed=seed), seed=seed, progress=progress)
+
+
+def definition_line(path: str | os.PathLike[str], message: str) -> int | None:
+    """The 1-based line of ``path`` that defines the expression or eye behaviour a
+    generator's error ``message`` names (``... 'name' ...``), or None.
+
+    Generators see definitions as plain mappings without their script lines; this finds
+    ``define_gaze { "name"`` / ``define_expression { "name"`` (or ``name = {`` in a
+    ``behaviours``/``expressions`` table) so the error can point at it.
+    """
+    quoted = re.findall(r"'([^']+)'", message)
+    if not quoted:
+        return None
+    try:
+        lines = Path(path).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return None
+    name = re.escape(quoted[0])
+    pattern = re.compile(
+        rf"define_\w+\s*\{{\s*[\"']{name}[\"']|(^|[{{,\s]){name}\s*=\s*\{{")
+    for number, line in enumerate(lines, 1):
+        if pattern.search(line.split("--", 1)[0]):
+            return number
+    return None

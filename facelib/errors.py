@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 __all__ = [
+    "ArkitFormatError",
     "DataError",
     "FaceModelError",
     "FacelibError",
@@ -64,6 +65,10 @@ class DataError(FacelibError):
 
 class FapFormatError(FacelibError):
     """A ``.fap`` file (or FAP data) cannot be read or is malformed."""
+
+
+class ArkitFormatError(FacelibError):
+    """An ARKit capture (Live Link Face CSV) or ARKit JSON file cannot be read."""
 
 
 class FdlError(FacelibError):

@@ -3,7 +3,8 @@
 import subprocess
 import sys
 
-HEAVY = ("OpenGL", "pyrender", "pocketsphinx", "matplotlib", "pyglet", "imageio_ffmpeg", "trimesh")
+HEAVY = ("OpenGL", "pyrender", "pocketsphinx", "matplotlib", "pyglet", "imageio_ffmpeg", "trimesh",
+         "pygltflib")
 
 
 def test_import_facelib_is_light():

@@ -13,7 +13,8 @@ Deformation of one frame ``f`` (84 FAP values):
    ``f_3 * MNS`` plus the thrust (FAP 14) and shift (FAP 15) translations;
 5. the head rotates about its pivot (FAP 48-50), fading to nothing over the neck.
 
-FAPs 1-2 (high-level visemes and expressions, expanded by the generators), 29-30 (pupil
+FAPs 1-2 (high-level visemes and expressions) are decoded into low-level FAPs by ``deform``
+(:mod:`facelib.mpeg4.highlevel`); 29-30 (pupil
 dilation) and 47 (tongue roll) do not move this mesh.
 """
 
@@ -31,6 +32,7 @@ from facelib.engine import rigid
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
 from facelib.errors import FaceModelError, ParameterError
+from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 
@@ -240,14 +242,25 @@ class Face:
             _steps=steps,
         )
 
+    def __repr__(self) -> str:
+        """One line: sizes and names, never the arrays."""
+        return (f"Face(vertices={len(self.vertices)}, triangles={len(self.triangles)}, "
+                f"parts=[{', '.join(self.parts)}], feature_points={len(self.feature_points)}, "
+                f"regions={len(self.regions)})")
+
     @property
     def n_vertices(self) -> int:
         return int(self.vertices.shape[0])
 
     def deform(self, stream: FapStream) -> np.ndarray:
-        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``."""
+        """Vertex positions for every frame of a stream: ``(n_frames, V, 3) float32``.
+
+        High-level FAPs 1 and 2 (viseme and expression selects and blends) are decoded
+        first (:func:`facelib.mpeg4.highlevel.apply_high_level`), as an MPEG-4 player does.
+        """
         if not isinstance(stream, FapStream):
             raise ParameterError(f"deform() takes a FapStream, not {type(stream).__name__}")
+        stream = apply_high_level(stream)  # FAP 1/2 from other tools' files
         return self._deform(np.asarray(stream.values, dtype=np.float32))
 
     def deform_frame(self, values: np.ndarray) -> np.ndarray:

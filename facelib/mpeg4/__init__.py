@@ -1,7 +1,14 @@
 """The MPEG-4 facial animation vocabulary: FAP and feature-point tables, FAPU, streams and
 ``.fap`` files."""
 
-from facelib.mpeg4.fapfile import DIALECTS, FapFile, read_fap, read_fap_file, write_fap
+from facelib.mpeg4.fapfile import (
+    DIALECTS,
+    FapFile,
+    format_fap,
+    read_fap,
+    read_fap_file,
+    write_fap,
+)
 from facelib.mpeg4.stream import EXPRESSION_FIELDS, VISEME_FIELDS, FapStream
 from facelib.mpeg4.tables import (
     ANGLE_UNIT,
@@ -38,6 +45,7 @@ __all__ = [
     "fap_table",
     "feature_point",
     "feature_point_table",
+    "format_fap",
     "read_fap",
     "read_fap_file",
     "write_fap",

@@ -51,10 +51,12 @@ from facelib.mpeg4.stream import (
 )
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
-__all__ = ["DIALECTS", "FapFile", "read_fap", "read_fap_file", "write_fap"]
+__all__ = ["DIALECTS", "FapFile", "format_fap", "read_fap", "read_fap_file", "write_fap"]
 
 DIALECTS: tuple[str, ...] = ("standard", "xface", "greta", "vreng", "extended")
 _GRETA_MASK = N_STANDARD_FAPS + 1
+_GRETA_FPS = 25  # Greta's Java reader: Constants.FRAME_PER_SECOND (fap_players.md M10)
+_GRETA_CPP_FRAMES = 8000  # Greta's C++ reader: fap1[8000][4], fap2[8000][6] (M8)
 _GROUP = {0: len(VISEME_FIELDS), 1: len(EXPRESSION_FIELDS)}
 _FIELD_LIMITS = {0: VISEME_LIMITS, 1: EXPRESSION_LIMITS}
 VALUE_LIMIT = 2**31 - 1
@@ -397,31 +399,47 @@ def write_fap(
     path:
         The file to write.
     dialect:
-        Any of :data:`DIALECTS`, each read back as that dialect: ``"standard"`` (68 mask
-        tokens, integer values: every player reads it), ``"xface"`` (68 mask tokens, values
-        with decimals, plus the FAP 1/2 token groups), ``"greta"`` (69 mask tokens),
-        ``"vreng"`` (standard with frames numbered from 1, tab-separated) or
-        ``"extended"`` (84 mask tokens with facelib's FAPs 69-84, plus FAP 1/2).
+        ``"standard"`` (68 mask tokens, integer values: the recommended choice, read
+        correctly by Xface, Greta (Java and C++) and VREng), ``"xface"`` (standard with
+        values to 3 decimals plus the FAP 1/2 token groups; warns when it writes them:
+        Greta's Java reader and VREng shift every later value), ``"greta"`` (69 mask
+        tokens, the 69th always 0, as Greta writes), ``"vreng"`` (standard with frames
+        numbered from 1, tab-separated) or ``"extended"`` (84 mask tokens with facelib's
+        FAPs 69-84, plus FAP 1/2; only facelib reads it). Every dialect but ``extended``
+        warns, naming them, when it drops extended FAPs 69-84 that carry values; ``greta``
+        warns unless the stream has 25 fps (Greta plays every file at 25), ``xface`` and
+        ``extended`` when over 8000 frames carry FAP 1/2 (Greta's C++ reader crashes).
     name:
         The header's name; default: the file's stem. Spaces become underscores.
 
     Returns the path written.
     """
+    path = Path(path)
+    text = format_fap(stream, dialect=dialect, name=name if name is not None else path.stem)
+    write_text_atomic(path, text)
+    return path
+
+
+def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "facelib") -> str:
+    """The text of a ``.fap`` file holding ``stream`` (see :func:`write_fap` for
+    ``dialect``); ``name`` goes into the header, spaces becoming underscores."""
     if dialect not in DIALECTS:
         raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
                              f"{stream.fps:g} fps: resample it first (stream.resample(25))")
     _check_range(stream)
-    path = Path(path)
-    label = "_".join((name if name is not None else path.stem).split()) or "facelib"
+    label = "_".join(name.split()) or "facelib"
     width = {"greta": _GRETA_MASK, "extended": N_FAPS}.get(dialect, N_STANDARD_FAPS)
     high_level = dialect in ("xface", "extended")
+    _warn_dropped(stream, label, dialect)
     values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
         str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
     first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
     mask = np.zeros((stream.n_frames, width), bool)
-    mask[:, : min(width, N_FAPS)] = stream.mask[:, : min(width, N_FAPS)]
+    # Greta's 69th slot is unused: FAP 69 (an extended FAP) must never land there
+    kept = min(width, N_FAPS if dialect == "extended" else N_STANDARD_FAPS)
+    mask[:, :kept] = stream.mask[:, :kept]
     if not high_level:
         mask[:, :2] = False
     else:
@@ -439,11 +457,41 @@ def write_fap(
             else:
                 tokens.append(values[i * N_FAPS + slot])
         out.append(sep.join(tokens))
-    write_text_atomic(path, "\n".join(out) + "\n")
-    return path
+    return "\n".join(out) + "\n"
 
 
 def _decimal(value: float) -> str:
     """``value`` with up to 3 decimals and at least one (``100.0``, ``-12.5``)."""
     text = f"{value:.3f}".rstrip("0")
     return text + "0" if text.endswith(".") else text
+
+
+def _warn_dropped(stream: FapStream, path: str, dialect: str) -> None:
+    """Warn about what a dialect cannot carry: extended FAPs 69-84 outside ``extended``, and
+    the FAP 1/2 token groups of ``xface`` that Greta's Java reader and VREng misread."""
+    if dialect != "extended":
+        used = (stream.mask[:, N_STANDARD_FAPS:] & (stream.values[:, N_STANDARD_FAPS:] != 0))
+        dropped = [int(i) + N_STANDARD_FAPS + 1 for i in np.flatnonzero(used.any(axis=0))]
+        if dropped:
+            warnings.warn(
+                f"{path}: the {dialect} dialect has no extended FAPs; dropping FAP "
+                f"{', '.join(map(str, dropped))} (write dialect='extended' to keep them; "
+                "only facelib reads that dialect)", FacelibWarning, stacklevel=3)
+    if dialect == "greta" and stream.fps != _GRETA_FPS:
+        warnings.warn(
+            f"{path}: Greta's Java reader ignores the header's frame rate and plays "
+            f"{_GRETA_FPS} fps; this stream has {stream.fps:g} fps (resample it: "
+            f"stream.resample({_GRETA_FPS}))", FacelibWarning, stacklevel=3)
+    high_level = stream.mask[:, :2].any() and (
+        stream.viseme is not None or stream.expression is not None)
+    if high_level and dialect in ("xface", "extended") and stream.n_frames > _GRETA_CPP_FRAMES:
+        warnings.warn(
+            f"{path}: {stream.n_frames} frames with FAP 1/2: Greta's C++ reader keeps them in "
+            f"arrays of {_GRETA_CPP_FRAMES} frames and crashes on longer files",
+            FacelibWarning, stacklevel=3)
+    if dialect == "xface" and high_level:
+        warnings.warn(
+            f"{path}: the xface dialect writes FAP 1/2 as 4- and 6-token groups, which Greta's "
+            "Java reader and VREng read as one token each, shifting every later value of "
+            "the frame; dialect='standard' is read correctly by every player",
+            FacelibWarning, stacklevel=3)

@@ -43,7 +43,8 @@ class FapStream:
         column ``k - 1`` holds FAP ``k``. Values where ``mask`` is False are 0.
     mask:
         ``(n_frames, 84) bool``: which FAPs each frame sets. Columns 0 and 1 (FAP 1, 2)
-        say whether the frame carries viseme / expression data.
+        say whether the frame carries viseme / expression data. None (the default) sets
+        the FAPs whose values are non-zero in some frame, in every frame.
     viseme:
         ``(n_frames, 4) int16`` with columns ``VISEME_FIELDS``, or None.
     expression:
@@ -73,8 +74,8 @@ class FapStream:
             raise ParameterError(
                 f"values must be finite, frame {frame} FAP {col + 1} is {values[frame, col]}"
             )
-        if self.mask is None:
-            mask = np.ones(values.shape, dtype=bool)
+        if self.mask is None:  # the FAPs the values use: a column of zeros sets nothing
+            mask = np.broadcast_to(values.any(axis=0), values.shape).copy()
             mask[:, :2] = False
         else:
             mask = np.asarray(self.mask)

@@ -9,7 +9,6 @@ the headless platform chosen by :mod:`facelib.rendering.platform`.
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import numpy as np
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS
+from facelib.progress import ProgressCallback, progress_callback
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import open_writer, save_png
@@ -62,27 +62,22 @@ def face_or_default(face: Deformable | str | os.PathLike[str] | None,
 
 
 def iter_frames(
-    renderer: FaceRenderer, face: Deformable, stream: FapStream, *, progress: bool = False
+    renderer: FaceRenderer, face: Deformable, stream: FapStream, *,
+    progress: bool | ProgressCallback | None = False,
 ) -> Iterator[np.ndarray]:
-    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``."""
-    bar = None
-    if progress and sys.stderr.isatty():
-        try:
-            from tqdm import tqdm
-        except ImportError:
-            bar = None
-        else:
-            bar = tqdm(total=stream.n_frames, unit="frame", desc="rendering", leave=False)
-    try:
-        for start in range(0, stream.n_frames, _CHUNK):
-            vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
-            for frame_vertices in vertices:
-                yield renderer.frame(frame_vertices)
-                if bar is not None:
-                    bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
+    """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``.
+
+    ``progress``: see :mod:`facelib.progress`; called with (frames done, n_frames).
+    """
+    report = progress_callback(progress, "rendering", unit="frames")
+    done = 0
+    for start in range(0, stream.n_frames, _CHUNK):
+        vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
+        for frame_vertices in vertices:
+            yield renderer.frame(frame_vertices)
+            done += 1
+            if report is not None:
+                report(done, stream.n_frames)
 
 
 def render(
@@ -95,7 +90,7 @@ def render(
     audio: str | os.PathLike[str] | None = None,
     audio_offset: float | None = None,
     background: Sequence[float] | None = None,
-    progress: bool = True,
+    progress: bool | ProgressCallback | None = True,
     fps: float | None = None,
 ) -> np.ndarray | Path:
     """Render an animation of ``face`` driven by ``source``.
@@ -114,7 +109,8 @@ def render(
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
     background: sRGB colour in [0, 1] behind the face; None uses the look's.
-    progress: show a progress bar when stderr is a terminal.
+    progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
+        None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
     fps: resample the stream to this frame rate first (None keeps the stream's).
 
     Returns

@@ -10,6 +10,9 @@ from __future__ import annotations
 import os
 import sys
 import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +23,7 @@ from facelib.rendering.platform import import_pyrender
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
 
-__all__ = ["has_display", "view"]
+__all__ = ["Playback", "has_display", "view"]
 
 
 def has_display() -> bool:
@@ -30,6 +33,65 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+@dataclass
+class Playback:
+    """Where playback stands: the frame shown, paused or running, and the wall-clock time
+    frame 0 would have been shown at (moved on pause, resume and steps). Mutated only by
+    the viewer's key callbacks and its playback loop, both under ``view``'s control."""
+
+    fps: float
+    n_frames: int
+    paused: bool = False
+    index: int = 0
+    origin: float = field(default_factory=time.perf_counter)
+
+    def toggle(self) -> None:
+        """Space: pause, or resume from the frame shown."""
+        self.paused = not self.paused
+        if not self.paused:
+            self.origin = time.perf_counter() - self.index / self.fps
+
+    def step(self, frames: int) -> None:
+        """Arrow keys: pause and move ``frames`` (clamped to the stream)."""
+        self.paused = True
+        self.index = min(max(self.index + frames, 0), self.n_frames - 1)
+
+    def due(self) -> int:
+        """The frame to show now (the index itself while paused)."""
+        if not self.paused:
+            self.index = int((time.perf_counter() - self.origin) * self.fps)
+        return self.index
+
+
+def _keys(state: Playback) -> dict[Any, Any]:
+    """pyrender's ``registered_keys``: space pauses, left/right step one frame, up/down
+    ten (pyrender keeps its own: q quits, z resets the view)."""
+    from pyglet.window import key
+
+    return {
+        key.SPACE: (lambda viewer: state.toggle()),
+        key.LEFT: (lambda viewer: state.step(-1)),
+        key.RIGHT: (lambda viewer: state.step(1)),
+        key.DOWN: (lambda viewer: state.step(-10)),
+        key.UP: (lambda viewer: state.step(10)),
+    }
+
+
+def _sound(audio: Path | None, offset: float) -> Any:
+    """A started pyglet player for ``audio`` (None without audio or an audio device)."""
+    if audio is None or offset < 0:
+        return None
+    try:
+        import pyglet.media
+
+        source = pyglet.media.load(str(audio), streaming=False)
+        player = pyglet.media.Player()
+        player.queue(source)
+        return player
+    except Exception:  # no driver, no device, unreadable: play silently  # noqa: BLE001
+        return None
+
+
 def view(
     source: FapStream | HasFaps,
     *,
@@ -37,13 +99,16 @@ def view(
     width: int = 800,
     height: int = 600,
     loop: bool = False,
+    sound: bool = True,
 ) -> None:
     """Open a window that plays ``source`` (FapStream or animation with ``.faps``) on ``face``.
 
     Frames follow the wall clock (frames are skipped, never slowed, when rendering lags);
-    the mouse orbits and zooms as in pyrender's viewer; closing the window stops playback.
-    ``loop`` replays until the window is closed. Audio is not played. Blocks until the
-    window closes or playback ends.
+    the mouse orbits and zooms as in pyrender's viewer. Space pauses and resumes, the left
+    and right arrows step one frame (up/down: ten), q closes. With ``sound`` the speech
+    audio of an animation plays in sync through pyglet where an audio device exists
+    (silently otherwise); it stops on pause. The window closes at the end unless ``loop``,
+    which replays until it is closed. Blocks until then.
     """
     if not has_display():
         raise RenderError(
@@ -58,35 +123,55 @@ def view(
             "this process already rendered offscreen (PyOpenGL is bound to "
             f"{os.environ['PYOPENGL_PLATFORM']!r}); open the viewer in a fresh process"
         )
-    stream, _, _ = stream_of(source)
+    stream, audio, offset = stream_of(source)
     face = face_or_default(face, source)
     pr = import_pyrender(offscreen=False)
     scene = FaceRenderer(face, width=width, height=height, mesh_update="swap", offscreen=False)
+    state = Playback(stream.fps, stream.n_frames)
     try:
         viewer = pr.Viewer(
             scene.scene, viewport_size=(width, height), run_in_thread=True,
+            registered_keys=_keys(state),
             window_title=f"facelib: {stream.n_frames} frames at {stream.fps:g} fps",
         )
     except Exception as exc:
         raise RenderError(f"could not open a window ({type(exc).__name__}: {exc})") from exc
     frames = np.asarray(face.deform(stream), np.float32) if stream.n_frames else None
+    player = _sound(audio, offset) if sound else None
     try:
         while frames is not None and viewer.is_active:
-            start = time.perf_counter()
-            shown = -1
-            while viewer.is_active:
-                index = int((time.perf_counter() - start) * stream.fps)
-                if index >= stream.n_frames:
-                    break
-                if index != shown:
-                    with viewer.render_lock:
-                        scene.set_vertices(frames[index])
-                    shown = index
-                time.sleep(max(0.0, (index + 1) / stream.fps - (time.perf_counter() - start)))
+            _play_once(viewer, scene, frames, state, player=player, offset=offset)
             if not loop:
                 break
-        while viewer.is_active and not loop:
-            time.sleep(0.05)
     finally:
+        if player is not None:
+            player.pause()
         if viewer.is_active:
             viewer.close_external()
+
+
+def _play_once(viewer: Any, scene: FaceRenderer, frames: np.ndarray, state: Playback, *,
+               player: Any, offset: float) -> None:
+    """Show ``frames`` from the first to the last, following ``state``'s clock."""
+    state.index, state.paused, state.origin = 0, False, time.perf_counter()
+    shown = -1
+    audio_started = False
+    while viewer.is_active:
+        index = state.due()
+        if index >= len(frames):
+            return
+        if player is not None:
+            at = index / state.fps - offset
+            if state.paused and audio_started:
+                player.pause()
+                audio_started = False
+            elif not state.paused and not audio_started and at >= 0:
+                player.seek(at)
+                player.play()
+                audio_started = True
+        if index != shown:
+            with viewer.render_lock:
+                scene.set_vertices(frames[index])
+            shown = index
+        time.sleep(0.01 if state.paused else
+                   max(0.0, (index + 1) / state.fps - (time.perf_counter() - state.origin)))

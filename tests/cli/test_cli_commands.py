@@ -34,12 +34,16 @@ def test_check_reports_script_errors_with_file_and_line(tmp_path, capsys):
     assert f"{bad}:2" in err and "Traceback" not in err
 
 
-def test_run_writes_the_fap_and_needs_an_output(tmp_path, capsys):
+def test_run_writes_the_fap_and_defaults_to_the_current_directory(tmp_path, monkeypatch):
     out = tmp_path / "small.fap"
     assert main(["run", str(SMALL), "-o", str(out)]) == 0
     assert read_fap(out, strict=True).n_frames > 25
-    assert main(["run", str(SMALL)]) == 1  # the storyboard names no output
-    assert "give one with -o" in capsys.readouterr().err
+    here = tmp_path / "here"
+    here.mkdir()
+    monkeypatch.chdir(here)
+    assert main(["run", str(SMALL)]) == 0  # no output named: STEM.fap in the current folder
+    assert read_fap(here / "small.fap") == read_fap(out)
+    assert not (SMALL.parent / "small.fap").exists()
 
 
 def test_seed_option_changes_the_eyes(tmp_path):

@@ -21,8 +21,18 @@ def test_arrays_are_copied_read_only_and_typed():
     assert stream.mask.dtype == bool
     with pytest.raises(ValueError, match="read-only"):
         stream.values[0, 0] = 1
-    # default mask: every low-level FAP set, FAP 1/2 not
-    assert stream.mask[:, 2:].all() and not stream.mask[:, :2].any()
+    # default mask: the FAPs the values use (none here), never FAP 1/2
+    assert not stream.mask.any()
+
+
+def test_default_mask_marks_only_the_faps_the_values_use():
+    values = np.zeros((4, 84), np.float32)
+    values[1, 2] = 120.0  # open_jaw moves in one frame
+    values[:, 22] = -300.0  # eye yaw in all
+    stream = FapStream(25, values)
+    assert stream.active_faps() == (3, 23)
+    assert stream.mask[:, 2].all()  # set in every frame, zero or not: the FAP is in use
+    assert repr(stream) == "FapStream(fps=25, n_frames=4, duration=0.160s, active_faps=2)"
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,88 @@
+"""The names a storyboard may use, with a line on each: ``facelib list KIND``.
+
+Expressions come from the library (descriptions in ``facelib/data/catalog/expressions.csv``),
+eye behaviours from ``facelib/data/gaze/behaviours.json``, visemes from the MPEG-4 table
+``facelib/data/mpeg4_visemes.csv`` (every alias a script may use is listed with its viseme).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
+
+from facelib import data
+from facelib.errors import DataError, FacelibError
+
+__all__ = ["KINDS", "Entry", "catalog"]
+
+KINDS = ("expressions", "visemes", "behaviours", "voices")
+
+EXPRESSION_GALLERY = "docs/images/expressions.png"
+
+
+@dataclass(frozen=True, slots=True)
+class Entry:
+    """One listed name: ``name``, a one-line ``description`` and, for expressions, the
+    gallery image (a path in the facelib source tree) that shows it, else ``""``."""
+
+    name: str
+    description: str
+    image: str = ""
+
+
+def catalog(kind: str) -> tuple[Entry, ...]:
+    """The entries of ``kind``, one of :data:`KINDS`, in library order."""
+    if kind not in KINDS:
+        raise FacelibError(f"unknown kind {kind!r}; choose one of {', '.join(KINDS)}")
+    listers: dict[str, Callable[[], tuple[Entry, ...]]] = {
+        "expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
+        "voices": _voices}
+    return listers[kind]()
+
+
+@cache
+def _expressions() -> tuple[Entry, ...]:
+    from facelib.expressions import default_library
+
+    described = {row["name"]: (line, row) for line, row in
+                 data.csv_rows("catalog/expressions.csv")}
+    entries = []
+    for name in default_library().names:
+        if name not in described:
+            raise DataError(f"expression {name!r} has no description",
+                            path=str(data.path("catalog/expressions.csv")))
+        row = described[name][1]
+        entries.append(Entry(name, f"{row['description']} ({row['source']})",
+                             EXPRESSION_GALLERY))
+    return tuple(entries)
+
+
+@cache
+def _visemes() -> tuple[Entry, ...]:
+    entries = []
+    for _, row in data.csv_rows("mpeg4_visemes.csv"):
+        aliases = row["thesis_names"].split()
+        entries.append(Entry(
+            row["name"], f"viseme {row['id']}: {row['example_words']} "
+            f"(script names: {', '.join(aliases)})"))
+    return tuple(entries)
+
+
+@cache
+def _behaviours() -> tuple[Entry, ...]:
+    library = data.json_data("gaze/behaviours.json")
+    return tuple(Entry(name, str(spec.get("description", "")))
+                 for name, spec in library.items() if not name.startswith("_"))
+
+
+def _voices() -> tuple[Entry, ...]:
+    import importlib
+
+    speech = importlib.import_module("facelib.speech")
+    voices = getattr(speech, "voices", None)
+    if voices is None:
+        raise FacelibError("this facelib has no speech synthesis, so there are no voices: "
+                           "storyboards speak from recorded audio (say { ..., audio = ... }) "
+                           "or from text timed by phone durations")
+    return tuple(Entry(str(v.name), str(v.description)) for v in voices())

@@ -1,0 +1,516 @@
+"""Synthetic face datasets: N seeded clips with labels, locally or on a Dask cluster.
+
+A dataset spec (TOML, see ``docs/batch.md``) gives ranges; clip ``i`` draws its cues from
+``numpy.random.default_rng([spec.seed, i])`` and becomes a storyboard (kept as
+``clip.fdl``), an animation, rendered frames and labels. The draw depends only on the spec
+and ``i``, so a local run and a cluster run write the same bytes, and any subset of clips
+can be (re)made in any order.
+
+Layout of ``OUT_DIR``::
+
+    spec.json                the spec's settings (a rerun must use the same)
+    spec.toml                the spec file it was read from (when it was)
+    index.jsonl              one line per clip: id, seed, frames, its draw (written last)
+    clip_000000/
+        clip.fdl             the storyboard drawn for the clip (run it with facelib)
+        clip.fap             the animation's FAP stream (standard .fap)
+        frames/frame_NNNNNN.png, or clip.mp4 (``media``)
+        frames.jsonl         per frame: time, expressions, eye behaviour, viseme, head
+                             pose, and 2-D pixel positions of every feature point
+        meta.json            the clip's draw, camera, image size and fps
+
+Each clip is made in a hidden temporary folder and renamed into place when complete, so
+``clip_NNNNNN/`` either is whole or does not exist; a rerun skips the clips that exist.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import tempfile
+import time
+import tomllib
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facelib.atomic import write_text_atomic
+from facelib.checks import check_count, check_fps, check_number
+from facelib.errors import FacelibError, ParameterError
+from facelib.progress import ProgressCallback, progress_callback
+
+__all__ = ["ClipDraw", "DatasetReport", "DatasetSpec", "draw_clip", "generate", "load_spec",
+           "make_clip"]
+
+MEDIA = ("png", "mp4", "none")
+CLIP_PATTERN = "clip_{:06d}"
+# head pose FAPs 48-50 (pitch, yaw, roll) in angle units of 1e-5 rad
+_HEAD_FAPS = (48, 49, 50)
+_AU_PER_DEG = math.pi / 180 * 1e5
+
+
+_DEFAULT_HEAD_DEG = ((-8.0, 8.0), (-15.0, 15.0), (-5.0, 5.0))
+"""Pitch, yaw and roll ranges of the head in degrees unless a spec says otherwise."""
+
+@dataclass(frozen=True)
+class DatasetSpec:
+    """What to generate. Ranges are ``(low, high)`` drawn uniformly.
+
+    clips: number of clips; seed: the dataset's seed; fps; seconds: clip length;
+    width, height: image size in pixels; media: ``"png"`` frames, ``"mp4"`` or ``"none"``
+    (labels and FAPs only). expressions: names drawn from (default: the whole library);
+    expressions_per_clip: ``(min, max)`` cues; intensity: range. behaviours: eye behaviours
+    drawn per clip (each with a mode, ``talking`` or ``listening``). head_deg: ranges of the
+    head's pitch, yaw, roll offset in degrees. texts: sentences a clip may say (text-only
+    speech timed by phone durations); speech_probability: chance that a clip speaks.
+    zoom, shift: camera framing: the framed box scaled by ``zoom`` and moved by ``shift``
+    times the face's size, horizontally and vertically.
+    """
+
+    clips: int
+    seed: int = 0
+    fps: float = 25.0
+    seconds: float = 2.0
+    width: int = 256
+    height: int = 256
+    media: str = "png"
+    expressions: tuple[str, ...] = ()
+    expressions_per_clip: tuple[int, int] = (1, 2)
+    intensity: tuple[float, float] = (0.5, 1.0)
+    behaviours: tuple[str, ...] = ("default",)
+    head_deg: tuple[tuple[float, float], ...] = _DEFAULT_HEAD_DEG
+    texts: tuple[str, ...] = ()
+    speech_probability: float = 0.5
+    zoom: tuple[float, float] = (0.9, 1.2)
+    shift: tuple[float, float] = (-0.05, 0.05)
+    source: str = field(default="", compare=False)
+
+    def __post_init__(self) -> None:
+        check_count("clips", self.clips, low=1)
+        check_count("seed", self.seed)
+        check_fps(self.fps)
+        check_number("seconds", self.seconds, low=0, low_open=True, high=3600)
+        if self.media not in MEDIA:
+            raise ParameterError(f"media must be one of {MEDIA}, got {self.media!r}")
+        low, high = self.expressions_per_clip
+        if not 0 <= low <= high:
+            raise ParameterError(f"expressions_per_clip must be (min, max) with 0 <= min <= "
+                                 f"max, got {self.expressions_per_clip!r}")
+        for name, pair in (("intensity", self.intensity), ("zoom", self.zoom),
+                           ("shift", self.shift), *zip(("pitch", "yaw", "roll"),
+                                                       self.head_deg, strict=True)):
+            if len(pair) != 2 or pair[0] > pair[1]:
+                raise ParameterError(f"{name} must be a range [low, high], got {pair!r}")
+        check_number("speech_probability", self.speech_probability, low=0, high=1)
+        if not self.behaviours:
+            raise ParameterError("behaviours must name at least one eye behaviour")
+
+
+def _pair(value: Any, key: str, path: str) -> tuple[float, float]:
+    if (not isinstance(value, list) or len(value) != 2
+            or not all(isinstance(v, int | float) for v in value)):
+        raise FacelibError(f"{key} must be a range [low, high], got {value!r}", path=path)
+    return float(value[0]), float(value[1])
+
+
+_TOP_KEYS = {"clips", "seed", "fps", "seconds", "width", "height", "media"}
+_SECTIONS = {
+    "expressions": {"names", "per_clip", "intensity"},
+    "gaze": {"behaviours"},
+    "head": {"pitch_deg", "yaw_deg", "roll_deg"},
+    "speech": {"texts", "probability"},
+    "camera": {"zoom", "shift"},
+}
+
+
+def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
+    """Read a dataset spec (TOML); unknown keys and bad values raise FacelibError naming
+    the file."""
+    where = str(path)
+    try:
+        raw = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise FacelibError(f"cannot read the dataset spec ({exc.strerror})", path=where) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise FacelibError(f"not valid TOML: {exc}", path=where) from None
+    for key, value in raw.items():
+        allowed = _SECTIONS.get(key)
+        if allowed is None and key not in _TOP_KEYS:
+            raise FacelibError(f"unknown setting {key!r}; expected one of "
+                               f"{sorted(_TOP_KEYS | set(_SECTIONS))}", path=where)
+        if allowed is not None and (not isinstance(value, dict) or set(value) - allowed):
+            raise FacelibError(f"[{key}] takes {sorted(allowed)}, got {value!r}", path=where)
+    options: dict[str, Any] = {k: raw[k] for k in _TOP_KEYS if k in raw}
+    expressions = raw.get("expressions", {})
+    if "names" in expressions:
+        options["expressions"] = tuple(expressions["names"])
+    if "per_clip" in expressions:
+        low, high = _pair(expressions["per_clip"], "expressions.per_clip", where)
+        options["expressions_per_clip"] = (int(low), int(high))
+    if "intensity" in expressions:
+        options["intensity"] = _pair(expressions["intensity"], "expressions.intensity", where)
+    if "behaviours" in raw.get("gaze", {}):
+        options["behaviours"] = tuple(raw["gaze"]["behaviours"])
+    head = raw.get("head", {})
+    options["head_deg"] = tuple(
+        _pair(head[k], f"head.{k}", where) if k in head else default
+        for k, default in zip(("pitch_deg", "yaw_deg", "roll_deg"),
+                              _DEFAULT_HEAD_DEG,
+                              strict=True))
+    speech = raw.get("speech", {})
+    if "texts" in speech:
+        options["texts"] = tuple(str(t) for t in speech["texts"])
+    if "probability" in speech:
+        options["speech_probability"] = speech["probability"]
+    camera = raw.get("camera", {})
+    for key in ("zoom", "shift"):
+        if key in camera:
+            options[key] = _pair(camera[key], f"camera.{key}", where)
+    try:
+        return DatasetSpec(**options, source=Path(path).read_text(encoding="utf-8"))
+    except (ParameterError, TypeError) as exc:
+        raise FacelibError(str(exc), path=where) from None
+
+
+@dataclass(frozen=True)
+class ClipDraw:
+    """What clip ``index`` shows: its seed (for the gaze and sync processes), expression cues
+    ``(name, start_s, duration_s, intensity)``, eye behaviour and mode, the sentence it
+    says (or None), head offset ``(pitch, yaw, roll)`` in degrees, camera zoom and shift."""
+
+    index: int
+    seed: int
+    expressions: tuple[tuple[str, float, float, float], ...]
+    behaviour: str
+    mode: str
+    text: str | None
+    head_deg: tuple[float, float, float]
+    zoom: float
+    shift: tuple[float, float]
+
+
+def _library_names() -> tuple[str, ...]:
+    from facelib.expressions import default_library
+
+    return default_library().names
+
+
+def draw_clip(spec: DatasetSpec, index: int) -> ClipDraw:
+    """The draw of clip ``index``: a pure function of ``spec`` and ``index``."""
+    rng = np.random.default_rng([spec.seed, index])
+    names = spec.expressions or _library_names()
+    n_cues = int(rng.integers(spec.expressions_per_clip[0], spec.expressions_per_clip[1] + 1))
+    cues = []
+    for _ in range(n_cues):
+        start = float(rng.uniform(0, spec.seconds * 0.6))
+        duration = float(rng.uniform(0.3, spec.seconds - start)) if start < spec.seconds - 0.3 \
+            else spec.seconds - start
+        cues.append((str(names[int(rng.integers(len(names)))]), round(start, 3),
+                     round(duration, 3), round(float(rng.uniform(*spec.intensity)), 3)))
+    cues.sort(key=lambda c: c[1])
+    behaviour = str(spec.behaviours[int(rng.integers(len(spec.behaviours)))])
+    mode = ("talking", "listening")[int(rng.integers(2))]
+    speaks = bool(spec.texts) and float(rng.random()) < spec.speech_probability
+    text = str(spec.texts[int(rng.integers(len(spec.texts)))]) if speaks else None
+    head = tuple(round(float(rng.uniform(*r)), 3) for r in spec.head_deg)
+    zoom = round(float(rng.uniform(*spec.zoom)), 4)
+    shift = (round(float(rng.uniform(*spec.shift)), 4), round(float(rng.uniform(*spec.shift)), 4))
+    return ClipDraw(index, int(rng.integers(2**31 - 1)), tuple(cues), behaviour, mode, text,
+                    (head[0], head[1], head[2]), zoom, shift)
+
+
+def clip_storyboard(spec: DatasetSpec, draw: ClipDraw) -> str:
+    """The FDL text of a clip: settings, the speech, expression and gaze cues."""
+    lines = [f"-- clip {draw.index} of a facelib dataset (seed {spec.seed})",
+             f"fps = {spec.fps:g}", f"seed = {draw.seed}"]
+    if draw.text is not None:
+        lines.append(f"say {{ {json.dumps(draw.text)}, at = 0 }}")
+    for name, start, duration, intensity in draw.expressions:
+        lines.append(f'show {{ "{name}", at = {start:g}, dur = {duration:g}, '
+                     f"intensity = {intensity:g} }}")
+    behaviour_args = {"default": f'"{draw.mode}", 1.0, '}.get(draw.behaviour, "")
+    lines.append(f'look {{ "{draw.behaviour}", {behaviour_args}at = 0, dur = {spec.seconds:g} }}')
+    return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class DatasetReport:
+    """``written`` clips made now, ``skipped`` ones already there, ``failed`` as
+    ``(clip index, message)``, and the wall-clock ``seconds`` it took."""
+
+    written: int
+    skipped: int
+    failed: tuple[tuple[int, str], ...]
+    seconds: float
+
+
+def _with_head(stream: Any, head_deg: Sequence[float]) -> Any:
+    """``stream`` with the head pose offset added to FAPs 48-50 in every frame."""
+    from facelib.mpeg4 import FapStream
+
+    values = np.array(stream.values)
+    mask = np.array(stream.mask)
+    for fap_id, degrees in zip(_HEAD_FAPS, head_deg, strict=True):
+        values[:, fap_id - 1] += np.float32(degrees * _AU_PER_DEG)
+        mask[:, fap_id - 1] = True
+    return FapStream(stream.fps, values, mask, stream.viseme, stream.expression)
+
+
+def _framing(face: Any, zoom: float, shift: Sequence[float]) -> np.ndarray:
+    """``(8, 3)`` corners of the box the camera frames: the neutral face's box scaled by
+    ``1 / zoom`` (zoom > 1 comes closer) and moved by ``shift`` times its size."""
+    vertices = np.asarray(face.vertices, np.float64)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    centre, half = (lo + hi) / 2, (hi - lo) / 2 / zoom
+    centre = centre + np.array([shift[0] * (hi - lo)[0], shift[1] * (hi - lo)[1], 0.0])
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    return centre + signs * half
+
+
+def _frame_labels(animation: Any, stream: Any) -> list[dict[str, Any]]:
+    """Per frame: time, active expression cues with intensity, eye behaviour, viseme and
+    head pose in degrees (from the final FAPs 48-50)."""
+    storyboard = animation.storyboard
+    spans = list(animation.visemes or ())
+    head = stream.values[:, [f - 1 for f in _HEAD_FAPS]] / _AU_PER_DEG
+    labels = []
+    for i in range(stream.n_frames):
+        ms = i * 1000 / stream.fps
+        labels.append({
+            "frame": i,
+            "time_s": round(i / stream.fps, 6),
+            "expressions": {c.name: c.intensity for c in storyboard.expressions
+                            if c.start_ms <= ms < c.end_ms},
+            "behaviour": next((g.behaviour for g in storyboard.gaze
+                               if g.start_ms <= ms < g.end_ms), None),
+            "viseme": next((s.name for s in spans if s.start_ms <= ms < s.end_ms), None),
+            "head_deg": [round(float(v), 4) for v in head[i]],
+        })
+    return labels
+
+
+def _render_clip(spec: DatasetSpec, draw: ClipDraw, stream: Any, folder: Path,
+                 labels: list[dict[str, Any]]) -> None:
+    """Render frames (or the mp4) and add each frame's feature-point pixels to ``labels``."""
+    from facelib.engine import default_face
+    from facelib.rendering.scene import FaceRenderer
+    from facelib.rendering.video import open_writer
+
+    face = default_face()
+    points = sorted(face.feature_points.items(), key=lambda kv: [int(p) for p in
+                                                                 kv[0].split(".")])
+    ids = np.array([v for _, v in points])
+    out = folder / ("clip.mp4" if spec.media == "mp4" else "frames")
+    with FaceRenderer(face, width=spec.width, height=spec.height,
+                      framing=_framing(face, draw.zoom, draw.shift)) as renderer:
+        writer = None if spec.media == "none" else open_writer(
+            out, fps=stream.fps, width=spec.width, height=spec.height)
+        try:
+            for start in range(0, stream.n_frames, 32):
+                vertices = np.asarray(face.deform(stream[start:start + 32]), np.float32)
+                for k, frame_vertices in enumerate(vertices):
+                    pixels = renderer.project(frame_vertices[ids])
+                    labels[start + k]["landmarks"] = {
+                        fp: [round(float(x), 3), round(float(y), 3)]
+                        for (fp, _), (x, y) in zip(points, pixels, strict=True)}
+                    if writer is not None:
+                        writer.write(renderer.frame(frame_vertices))
+        except BaseException:
+            if writer is not None:
+                writer.abort()
+            raise
+        if writer is not None:
+            writer.commit()
+
+
+def make_clip(spec: DatasetSpec, index: int, out_dir: str | os.PathLike[str]) -> str:
+    """Make clip ``index`` in ``out_dir`` unless it exists; returns ``"written"`` or
+    ``"skipped"``. Safe to run anywhere that sees ``out_dir`` (a Dask worker)."""
+    from facelib.animation import animate
+    from facelib.fdl import loads
+    from facelib.mpeg4 import write_fap
+
+    final = Path(out_dir) / CLIP_PATTERN.format(index)
+    if final.is_dir():
+        return "skipped"
+    draw = draw_clip(spec, index)
+    text = clip_storyboard(spec, draw)
+    temp = Path(tempfile.mkdtemp(dir=out_dir, prefix=f".{final.name}.", suffix=".tmp"))
+    try:
+        animation = animate(loads(text, name=f"{final.name}/clip.fdl"))
+        stream = _with_head(animation.faps, draw.head_deg)
+        stream = stream[: max(1, round(spec.seconds * spec.fps))]
+        (temp / "clip.fdl").write_text(text, encoding="utf-8")
+        write_fap(stream, temp / "clip.fap", name=final.name)
+        labels = _frame_labels(animation, stream)
+        _render_clip(spec, draw, stream, temp, labels)
+        (temp / "frames.jsonl").write_text(
+            "".join(json.dumps(row, sort_keys=True) + "\n" for row in labels), encoding="utf-8")
+        meta = {"draw": asdict(draw), "fps": spec.fps, "frames": stream.n_frames,
+                "width": spec.width, "height": spec.height, "media": spec.media}
+        (temp / "meta.json").write_text(json.dumps(meta, indent=1, sort_keys=True) + "\n",
+                                        encoding="utf-8")
+        temp.chmod(0o755)
+        temp.rename(final)
+    except BaseException:
+        shutil.rmtree(temp, ignore_errors=True)
+        raise
+    return "written"
+
+
+def _clip_task(spec: DatasetSpec, index: int, out_dir: str) -> tuple[int, str, str | None]:
+    """``(index, "written"/"skipped"/"failed", error)``: one clip, errors caught."""
+    try:
+        return index, make_clip(spec, index, out_dir), None
+    except FacelibError as exc:
+        return index, "failed", str(exc)
+    except Exception as exc:  # a worker must report, not die  # noqa: BLE001
+        return index, "failed", f"{type(exc).__name__}: {exc}"
+
+
+def _run_local(spec: DatasetSpec, todo: Sequence[int], out_dir: str, jobs: int,
+               report: ProgressCallback | None) -> list[tuple[int, str, str | None]]:
+    """The clips ``todo`` on ``jobs`` spawned worker processes (or in this one for 1)."""
+    import multiprocessing
+
+    from facelib.batch import _raise_on_sigterm
+
+    results: list[tuple[int, str, str | None]] = []
+    if jobs == 1:
+        for index in todo:
+            results.append(_clip_task(spec, index, out_dir))
+            if report is not None:
+                report(len(results), len(todo))
+        return results
+    pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_raise_on_sigterm)
+    try:
+        tasks = [(spec, i, out_dir) for i in todo]
+        for result in pool.imap_unordered(_star_clip_task, tasks):
+            results.append(result)
+            if report is not None:
+                report(len(results), len(todo))
+        pool.close()
+    except BaseException:
+        pool.terminate()
+        raise
+    finally:
+        pool.join()
+    return results
+
+
+def _star_clip_task(args: tuple[DatasetSpec, int, str]) -> tuple[int, str, str | None]:
+    return _clip_task(*args)
+
+
+def _run_dask(spec: DatasetSpec, todo: Sequence[int], out_dir: str, scheduler: Any,
+              report: ProgressCallback | None) -> list[tuple[int, str, str | None]]:
+    """The clips ``todo`` as tasks on a Dask cluster (``scheduler``: an address such as
+    ``tcp://host:8786``, or a ``distributed.Client``); workers write into ``out_dir``,
+    which they must see at the same path (a shared file system)."""
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        from facelib.errors import MissingExtraError
+
+        raise MissingExtraError("dataset generation on a Dask cluster", "scale",
+                                "distributed") from None
+    client = scheduler if isinstance(scheduler, Client) else Client(scheduler, timeout=30)
+    try:
+        futures = client.map(_clip_task, [spec] * len(todo), list(todo),
+                             [out_dir] * len(todo), pure=False)
+        results = []
+        try:
+            for future in as_completed(futures):
+                results.append(future.result())
+                if report is not None:
+                    report(len(results), len(todo))
+        except BaseException:
+            client.cancel(futures)
+            raise
+        return results
+    finally:
+        if client is not scheduler:
+            client.close()
+
+
+def _claim(spec: DatasetSpec, out: Path) -> None:
+    """Record the spec in ``out`` (``spec.json``, and ``spec.toml`` when read from one);
+    refuse a folder holding a dataset made from a different spec."""
+    settings = {k: v for k, v in asdict(spec).items() if k != "source"}
+    text = json.dumps(settings, indent=1, sort_keys=True) + "\n"
+    previous = out / "spec.json"
+    if previous.is_file() and previous.read_text(encoding="utf-8") != text:
+        raise FacelibError("this folder holds a dataset made from another spec; use a new "
+                           "folder (or delete this one)", path=str(previous))
+    write_text_atomic(previous, text)
+    if spec.source:
+        write_text_atomic(out / "spec.toml", spec.source)
+
+
+def _clean_stale(out: Path) -> None:
+    """Remove temporary clip folders left by a killed run (``.clip_NNNNNN.*.tmp``)."""
+    for stale in out.glob(".clip_*.tmp"):
+        shutil.rmtree(stale, ignore_errors=True)
+
+
+def write_index(spec: DatasetSpec, out_dir: str | os.PathLike[str]) -> Path:
+    """Write ``index.jsonl`` (one line per finished clip, in clip order) from the clips'
+    ``meta.json`` files; returns its path."""
+    out = Path(out_dir)
+    rows = []
+    for index in range(spec.clips):
+        meta_path = out / CLIP_PATTERN.format(index) / "meta.json"
+        if meta_path.is_file():
+            meta = json.loads(meta_path.read_text(encoding="utf-8"))
+            rows.append(json.dumps({"clip": CLIP_PATTERN.format(index), **meta},
+                                   sort_keys=True))
+    path = out / "index.jsonl"
+    write_text_atomic(path, "".join(r + "\n" for r in rows))
+    return path
+
+
+def generate(
+    spec: DatasetSpec,
+    out_dir: str | os.PathLike[str],
+    *,
+    jobs: int | None = None,
+    scheduler: Any = None,
+    progress: bool | ProgressCallback | None = None,
+) -> DatasetReport:
+    """Make every clip of ``spec`` in ``out_dir`` that is not there yet.
+
+    Locally with ``jobs`` spawned processes (default: the CPU count), or, given
+    ``scheduler`` (a Dask scheduler address or a ``distributed.Client``), as one task per
+    clip on that cluster. ``progress(clips_done, clips_to_make)``. Finished clips are
+    skipped, so an interrupted run is resumed by running it again. A failing clip is
+    reported in the result and the others are made. Writes ``spec.toml`` and, at the end,
+    ``index.jsonl``.
+    """
+    from facelib.batch import default_jobs
+
+    started = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    _claim(spec, out)
+    _clean_stale(out)
+    todo = [i for i in range(spec.clips) if not (out / CLIP_PATTERN.format(i)).is_dir()]
+    report = progress_callback(progress, "dataset", unit="clips")
+    if not todo:
+        results: list[tuple[int, str, str | None]] = []
+    elif scheduler is not None:
+        results = _run_dask(spec, todo, str(out.resolve()), scheduler, report)
+    else:
+        n_jobs = default_jobs() if jobs is None else check_count("jobs", jobs, low=1)
+        results = _run_local(spec, todo, str(out.resolve()), min(n_jobs, len(todo)), report)
+    write_index(spec, out)
+    failed = tuple(sorted((i, str(e)) for i, status, e in results if status == "failed"))
+    written = sum(status == "written" for _, status, _ in results)
+    return DatasetReport(written, spec.clips - len(todo) + sum(
+        status == "skipped" for _, status, _ in results), failed,
+        time.perf_counter() - started)
+

@@ -1,0 +1,25 @@
+"""Exports into other tools: glTF 2.0 with morph targets and a skin, ARKit-52 blendshape
+curves (Live Link Face CSV, JSON) and their import, and a static web player.
+
+Loaded on first use (``facelib.export_gltf`` ...); the glTF container needs the ``export``
+extra (pygltflib), the web player the npm build (``make web``).
+"""
+
+from facelib.export.arkit import ANGLE_NAMES, ArkitCurves, arkit_names, from_arkit, to_arkit
+from facelib.export.gltf import GltfExport, export_gltf
+from facelib.export.livelink import (
+    export_arkit,
+    import_arkit,
+    read_arkit_json,
+    read_live_link_csv,
+    write_arkit_json,
+    write_live_link_csv,
+)
+from facelib.export.web import WebExport, export_html
+
+__all__ = [
+    "ANGLE_NAMES", "ArkitCurves", "GltfExport", "WebExport", "arkit_names", "export_arkit",
+    "export_gltf", "export_html", "from_arkit", "import_arkit", "read_arkit_json",
+    "read_live_link_csv", "to_arkit", "write_arkit_json", "write_live_link_csv",
+]
+

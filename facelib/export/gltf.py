@@ -1,0 +1,282 @@
+"""glTF 2.0 export: the head with its vertex colours, sparse morph targets for the engine's
+linear basis, a skin for eyes, eyelids, jaw and head, and an animation of a FapStream.
+
+The container is built with pygltflib (``export`` extra). A frame of the animation evaluated
+as glTF specifies (morph targets, then linear blend skinning) gives ``Face.deform`` of that
+frame (see :mod:`facelib.export.rig` for the construction and its error bound).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facelib import data
+from facelib.atomic import atomic_path
+from facelib.engine import Face, default_face
+from facelib.errors import MissingExtraError, ParameterError
+from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
+from facelib.export.source import Source, resolve_source
+from facelib.mpeg4.tables import fap
+
+__all__ = ["GltfExport", "export_gltf"]
+
+_FLOAT, _USHORT, _UINT = 5126, 5123, 5125
+_ARRAY, _ELEMENTS = 34962, 34963
+_NORMAL_EPS = 1e-4  # normal changes below this are not stored
+
+
+@dataclass(frozen=True)
+class GltfExport:
+    """What :func:`export_gltf` wrote.
+
+    path: the ``.glb``; audio: the speech audio copied beside it, or None.
+    targets: FAP number of each morph target, in target order; scales: (T,) float32 the FAP
+        value at which each target's weight is 1 (the stream's largest magnitude).
+    n_frames, fps: the animation's frames (one keyframe per frame) and rate.
+    """
+
+    path: Path
+    audio: Path | None
+    targets: tuple[int, ...]
+    scales: np.ndarray
+    n_frames: int
+    fps: float
+
+
+class _Builder:
+    """Accessors over one binary buffer (each view 4-byte aligned, as glTF requires)."""
+
+    def __init__(self, gltf: Any, pygltflib: Any):
+        self.g, self.lib = gltf, pygltflib
+        self.chunks: list[bytes] = []
+        self.size = 0
+
+    def view(self, array: np.ndarray, target: int | None = None) -> int:
+        raw = np.ascontiguousarray(array).tobytes()
+        self.g.bufferViews.append(self.lib.BufferView(
+            buffer=0, byteOffset=self.size, byteLength=len(raw), target=target))
+        pad = (-len(raw)) % 4
+        self.chunks.append(raw + b"\0" * pad)
+        self.size += len(raw) + pad
+        return len(self.g.bufferViews) - 1
+
+    def accessor(self, array: np.ndarray, kind: str, *, target: int | None = None,
+                 bounds: bool = False) -> int:
+        component = {np.dtype(np.float32): _FLOAT, np.dtype(np.uint16): _USHORT,
+                     np.dtype(np.uint32): _UINT}[array.dtype]
+        flat = array.reshape(len(array), -1)
+        extra = {"min": flat.min(0).tolist(), "max": flat.max(0).tolist()} if bounds else {}
+        self.g.accessors.append(self.lib.Accessor(
+            bufferView=self.view(array, target), componentType=component, count=len(array),
+            type=kind, **extra))
+        return len(self.g.accessors) - 1
+
+    def sparse_target(self, count: int, ids: np.ndarray, values: np.ndarray, *,
+                      bounds: bool = True) -> int:
+        """A VEC3 float accessor of ``count`` zeros with ``values`` at ``ids`` (sorted);
+        ``bounds``: write min/max (required for POSITION targets)."""
+        lib = self.lib
+        sparse = None
+        lo, hi = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+        if len(ids):
+            index_type = np.uint16 if count < 65536 else np.uint32
+            sparse = lib.Sparse(
+                count=len(ids),
+                indices=lib.AccessorSparseIndices(
+                    bufferView=self.view(ids.astype(index_type)),
+                    componentType=_USHORT if index_type is np.uint16 else _UINT),
+                values=lib.AccessorSparseValues(bufferView=self.view(values.astype(np.float32))))
+            lo = np.minimum(values.min(0), 0).tolist()
+            hi = np.maximum(values.max(0), 0).tolist()
+        extra = {"min": lo, "max": hi} if bounds else {}
+        self.g.accessors.append(lib.Accessor(
+            byteOffset=None, componentType=_FLOAT, count=count, type="VEC3", sparse=sparse,
+            **extra))
+        return len(self.g.accessors) - 1
+
+    def blob(self) -> bytes:
+        return b"".join(self.chunks)
+
+
+def _import_pygltflib() -> Any:
+    try:
+        import pygltflib
+    except ImportError as exc:
+        raise MissingExtraError("glTF export", "export", "pygltflib") from exc
+    return pygltflib
+
+
+def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
+    """glTF vertex colours are linear; facelib's are sRGB."""
+    rgb = np.clip(np.asarray(rgb, np.float32), 0.0, 1.0)
+    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(V, 3) float32 unit area-weighted vertex normals ((0, 0, 1) where undefined)."""
+    v = vertices.astype(np.float64)
+    n = np.cross(v[triangles[:, 1]] - v[triangles[:, 0]], v[triangles[:, 2]] - v[triangles[:, 0]])
+    out = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(out, triangles[:, k], n)
+    length = np.linalg.norm(out, axis=1, keepdims=True)
+    out = np.where(length > 0, out / np.where(length > 0, length, 1), [0.0, 0.0, 1.0])
+    return out.astype(np.float32)
+
+
+def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
+    """One primitive per part; ``targets`` (T, V, 3) float32 displacements."""
+    lib = b.lib
+    look = data.json_data("render_look.json")["parts"]
+    normals = vertex_normals(face.vertices, face.triangles)
+    # each target's change of the normals, so that players shade the deformed face right
+    normal_turns = [vertex_normals(face.vertices + disp, face.triangles) - normals
+                    for disp in targets]
+    colours = _srgb_to_linear(face.vertex_colors)
+    joints = np.zeros((face.n_vertices, 4), np.uint16)
+    joints[:, :2] = rig.joints
+    weights = np.zeros((face.n_vertices, 4), np.float32)
+    weights[:, :2] = rig.weights
+    out = []
+    for name, part in face.parts.items():
+        ids = np.sort(part.vertex_ids.astype(np.int64))
+        local = np.full(face.n_vertices, -1, np.int64)
+        local[ids] = np.arange(len(ids))
+        tris = local[part.triangles].astype(np.uint16 if len(ids) < 65536 else np.uint32)
+        attributes = lib.Attributes(
+            POSITION=b.accessor(face.vertices[ids], "VEC3", target=_ARRAY, bounds=True),
+            NORMAL=b.accessor(normals[ids], "VEC3", target=_ARRAY),
+            COLOR_0=b.accessor(colours[ids], "VEC3", target=_ARRAY),
+            JOINTS_0=b.accessor(joints[ids], "VEC4", target=_ARRAY),
+            WEIGHTS_0=b.accessor(weights[ids], "VEC4", target=_ARRAY))
+        morph = []
+        for disp, turn in zip(targets, normal_turns, strict=True):
+            moved = np.flatnonzero(np.any(disp[ids] != 0, axis=1))
+            turned = np.flatnonzero(np.any(np.abs(turn[ids]) > _NORMAL_EPS, axis=1))
+            morph.append({"POSITION": b.sparse_target(len(ids), moved, disp[ids][moved]),
+                          "NORMAL": b.sparse_target(len(ids), turned, turn[ids][turned],
+                                                    bounds=False)})
+        material = look.get(name, look["default"])
+        b.g.materials.append(lib.Material(
+            name=name, doubleSided=True, pbrMetallicRoughness=lib.PbrMetallicRoughness(
+                baseColorFactor=[1.0, 1.0, 1.0, 1.0], metallicFactor=material["metallic"],
+                roughnessFactor=material["roughness"])))
+        out.append(lib.Primitive(
+            attributes=attributes, indices=b.accessor(tris.reshape(-1), "SCALAR",
+                                                      target=_ELEMENTS),
+            material=len(b.g.materials) - 1, targets=morph or None))
+    return out
+
+
+def _skeleton(b: _Builder, rig: Rig, pose: Pose) -> list[int]:
+    """Joint nodes (children linked), their skin, and return the joint node indices."""
+    lib = b.lib
+    first = len(b.g.nodes)
+    for j, name in enumerate(rig.names):
+        b.g.nodes.append(lib.Node(
+            name=name, translation=pose.translation[0, j].tolist(),
+            rotation=pose.rotation[0, j].tolist(),
+            children=[first + int(c) for c in np.flatnonzero(rig.parents == j)] or None))
+    inverse = np.tile(np.eye(4, dtype=np.float32), (len(rig.names), 1, 1))
+    inverse[:, 3, :3] = -rig.rest  # column-major: the translation is the 4th column
+    b.g.skins.append(lib.Skin(
+        name="face_rig", skeleton=first, joints=list(range(first, first + len(rig.names))),
+        inverseBindMatrices=b.accessor(inverse.reshape(-1, 16), "MAT4")))
+    return list(range(first, first + len(rig.names)))
+
+
+def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: Pose, *,
+               fps: float, mesh_node: int = 0) -> None:
+    """One keyframe per frame: morph weights and every joint transform that changes."""
+    lib = b.lib
+    n = len(weights)
+    channels: list[tuple[int, str, np.ndarray, str]] = []
+    if weights.size:
+        channels.append((mesh_node, "weights", weights.reshape(-1, 1), "SCALAR"))
+    for j, node in enumerate(joint_nodes):
+        for path, values, kind in (("rotation", pose.rotation[:, j], "VEC4"),
+                                   ("translation", pose.translation[:, j], "VEC3")):
+            if np.ptp(values, axis=0).max() > 0:
+                channels.append((node, path, values, kind))
+    if not channels or n < 1:
+        return
+    times = b.accessor((np.arange(n) / fps).astype(np.float32), "SCALAR", bounds=True)
+    animation = lib.Animation(name="facelib", samplers=[], channels=[])
+    for node, path, values, kind in channels:
+        animation.samplers.append(lib.AnimationSampler(
+            input=times, output=b.accessor(np.ascontiguousarray(values, np.float32), kind),
+            interpolation="LINEAR"))
+        animation.channels.append(lib.AnimationChannel(
+            sampler=len(animation.samplers) - 1,
+            target=lib.AnimationChannelTarget(node=node, path=path)))
+    b.g.animations.append(animation)
+
+
+def export_gltf(
+    source: Source,
+    out: str | os.PathLike[str],
+    *,
+    face: Face | None = None,
+    audio: str | os.PathLike[str] | None = None,
+) -> GltfExport:
+    """Write a binary glTF (``.glb``) of ``source`` played on ``face``.
+
+    Parameters
+    ----------
+    source: a FapStream, or an object with ``faps`` (and optionally ``audio`` and
+        ``audio_offset``) such as ``facelib.run_fdl``'s Animation.
+    out: the ``.glb`` path (written atomically).
+    face: the head (default: the bundled head).
+    audio: speech audio to copy beside the file (default: the source's own audio). glTF has
+        no audio: the copy is named in ``asset.extras.facelib.audio``.
+    """
+    lib = _import_pygltflib()
+    out = Path(out)
+    if out.suffix.lower() != ".glb":
+        raise ParameterError(f"export_gltf writes binary glTF: give a .glb path, not {out}")
+    stream, audio_path, offset = resolve_source(source, audio)
+    face = default_face() if face is None else face
+    rig = build_rig(face)
+    pose = pose_rig(face, rig, stream)
+    rows, values = morph_weights(face, stream)
+    scales = np.maximum(np.abs(values).max(axis=0), 1e-6).astype(np.float32) if len(
+        values) else np.ones(len(rows), np.float32)
+    dense = face.operator[rows].toarray().reshape(len(rows), face.n_vertices, 3)
+    targets = (dense * scales[:, None, None]).astype(np.float32)
+    copied = None
+    if audio_path is not None:
+        copied = out.with_suffix(audio_path.suffix.lower())
+        with atomic_path(copied) as temp:
+            shutil.copyfile(audio_path, temp)
+    g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
+    g.asset.extras = {"facelib": {
+        "fps": float(stream.fps), "n_frames": int(stream.n_frames),
+        "audio": copied.name if copied else None, "audio_offset": float(offset),
+        "targets": [{"fap": int(r) + 1, "name": fap(int(r) + 1).name, "scale": float(s)}
+                    for r, s in zip(rows, scales, strict=True)],
+        "joint_fractions": FRACTIONS}}
+    b = _Builder(g, lib)
+    mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, targets),
+                    weights=[0.0] * len(rows) if len(rows) else None)
+    if len(rows):
+        mesh.extras = {"targetNames": [f"fap{int(r) + 1}_{fap(int(r) + 1).name}" for r in rows]}
+    g.meshes.append(mesh)
+    g.nodes.append(lib.Node(name="face", mesh=0, skin=0))
+    joint_nodes = _skeleton(b, rig, pose)
+    g.scenes.append(lib.Scene(name="facelib", nodes=[0, joint_nodes[0]]))
+    g.scene = 0
+    _animation(b, joint_nodes, values / scales if len(rows) else values[:, :0], pose,
+               fps=float(stream.fps))
+    blob = b.blob()
+    g.buffers.append(lib.Buffer(byteLength=len(blob)))
+    g.set_binary_blob(blob)
+    with atomic_path(out) as temp:
+        temp.write_bytes(b"".join(g.save_to_bytes()))
+    return GltfExport(out, copied, tuple(int(r) + 1 for r in rows), scales,
+                      int(stream.n_frames), float(stream.fps))

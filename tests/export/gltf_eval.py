@@ -1,0 +1,109 @@
+"""An independent glTF evaluator for the tests: accessors (sparse included), morph targets
+and linear blend skinning at a keyframe, as the glTF 2.0 specification defines them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pygltflib
+from scipy.spatial.transform import Rotation
+
+from facelib import FapStream
+from facelib.mpeg4 import fap
+
+_DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32,
+           5126: np.float32}
+_WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+
+class Gltf:
+    def __init__(self, path: Path):
+        self.g = pygltflib.GLTF2.load(str(path))
+        self.blob = self.g.binary_blob()
+
+    def _view(self, index: int, dtype: type, count: int, width: int, offset: int = 0):
+        view = self.g.bufferViews[index]
+        start = (view.byteOffset or 0) + offset
+        return np.frombuffer(self.blob, dtype, count * width, start).reshape(count, width)
+
+    def accessor(self, index: int) -> np.ndarray:
+        a = self.g.accessors[index]
+        dtype, width = _DTYPES[a.componentType], _WIDTH[a.type]
+        if a.bufferView is None:
+            out = np.zeros((a.count, width), dtype)
+        else:
+            out = self._view(a.bufferView, dtype, a.count, width, a.byteOffset or 0).copy()
+        if a.sparse is not None:
+            s = a.sparse
+            ids = self._view(s.indices.bufferView, _DTYPES[s.indices.componentType], s.count, 1)
+            out[ids[:, 0]] = self._view(s.values.bufferView, dtype, s.count, width)
+        return out
+
+    def local_matrices(self, frame: int) -> list[np.ndarray]:
+        """Every node's local matrix at keyframe ``frame`` of the first animation."""
+        trs = {i: [np.array(n.translation or [0, 0, 0], float),
+                   np.array(n.rotation or [0, 0, 0, 1], float)]
+               for i, n in enumerate(self.g.nodes)}
+        weights = None
+        for ch in self.g.animations[0].channels:
+            sampler = self.g.animations[0].samplers[ch.sampler]
+            out = self.accessor(sampler.output)
+            if ch.target.path == "weights":
+                n_targets = len(self.g.meshes[0].weights)
+                weights = out.reshape(-1, n_targets)[frame].astype(float)
+            elif ch.target.path == "rotation":
+                trs[ch.target.node][1] = out[frame].astype(float)
+            elif ch.target.path == "translation":
+                trs[ch.target.node][0] = out[frame].astype(float)
+        mats = []
+        for i in range(len(self.g.nodes)):
+            m = np.eye(4)
+            m[:3, :3] = Rotation.from_quat(trs[i][1]).as_matrix()
+            m[:3, 3] = trs[i][0]
+            mats.append(m)
+        self._weights = weights
+        return mats
+
+    def evaluate(self, frame: int) -> list[np.ndarray]:
+        """World positions (Vp, 3) of each primitive of mesh 0 at keyframe ``frame``."""
+        local = self.local_matrices(frame)
+        parent = {c: i for i, n in enumerate(self.g.nodes) for c in (n.children or [])}
+
+        def world(i: int) -> np.ndarray:
+            return world(parent[i]) @ local[i] if i in parent else local[i]
+
+        skin = self.g.skins[0]
+        inverse = self.accessor(skin.inverseBindMatrices).reshape(-1, 4, 4).transpose(0, 2, 1)
+        joint_mats = np.stack([world(j) @ inverse[k] for k, j in enumerate(skin.joints)])
+        out = []
+        for prim in self.g.meshes[0].primitives:
+            pos = self.accessor(prim.attributes.POSITION).astype(float)
+            for t, target in enumerate(prim.targets or []):
+                pos += self._weights[t] * self.accessor(target["POSITION"])
+            joints = self.accessor(prim.attributes.JOINTS_0).astype(int)
+            weights = self.accessor(prim.attributes.WEIGHTS_0).astype(float)
+            homo = np.c_[pos, np.ones(len(pos))]
+            skinned = np.zeros_like(pos)
+            for k in range(4):
+                m = joint_mats[joints[:, k]]
+                skinned += weights[:, k:k + 1] * np.einsum("vij,vj->vi", m, homo)[:, :3]
+            out.append(skinned)
+        return out
+
+
+def busy_stream(n: int = 12) -> FapStream:
+    """Every rigid step at once: jaw, lids, eyes, head, plus lips, brows and FAP 1/2."""
+    t = np.linspace(0, 1, n)
+    values = np.zeros((n, 84), np.float32)
+    for name, amp in (("open_jaw", 500), ("thrust_jaw", 80), ("shift_jaw", -60),
+                      ("close_t_l_eyelid", 1000), ("close_t_r_eyelid", 700),
+                      ("close_b_l_eyelid", 300), ("yaw_l_eyeball", 20000),
+                      ("pitch_r_eyeball", -15000), ("thrust_l_eyeball", 100),
+                      ("head_pitch", 20000), ("head_yaw", -30000), ("head_roll", 12000),
+                      ("raise_l_i_eyebrow", 200), ("stretch_l_cornerlip", 150)):
+        values[:, fap(name).index] = amp * np.sin(np.pi * t)
+    mask = np.ones((n, 84), bool)
+    viseme = np.tile([10, 1, 40, 0], (n, 1))
+    expression = np.tile([1, 50, 0, 0, 0, 0], (n, 1))
+    return FapStream(25, values, mask, viseme, expression)

@@ -1,0 +1,96 @@
+"""glTF export: the file validates, and its morph targets and skin evaluated per the glTF
+specification reproduce ``Face.deform`` within 0.1 mm."""
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from gltf_eval import Gltf, busy_stream
+
+from facelib.engine import default_face
+from facelib.export import export_gltf
+
+WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    out = tmp_path_factory.mktemp("gltf") / "busy.glb"
+    return export_gltf(busy_stream(), out), busy_stream()
+
+
+def test_evaluated_gltf_matches_deform_within_a_tenth_of_a_millimetre(exported):
+    result, stream = exported
+    face = default_face()
+    want = face.deform(stream)
+    gltf = Gltf(result.path)
+    worst = 0.0
+    for frame in (0, 3, 6, 9, 11):
+        got = gltf.evaluate(frame)
+        for part, positions in zip(face.parts.values(), got, strict=True):
+            ids = np.sort(part.vertex_ids)
+            worst = max(worst, float(np.abs(positions - want[frame][ids]).max()))
+    assert worst < 1e-4, f"{worst * 1000:.4f} mm"
+    print(f"worst {worst * 1000:.5f} mm")
+    # the deformation is real: frame 6 moves the face by centimetres
+    assert np.abs(want[6] - face.vertices).max() > 0.01
+
+
+def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
+    result, _ = exported
+    g = Gltf(result.path).g
+    assert 3 in result.targets and 19 not in result.targets  # lids are joints, not targets
+    assert 48 not in result.targets and 1 not in result.targets
+    names = g.meshes[0].extras["targetNames"]
+    assert len(names) == len(result.targets) == len(g.meshes[0].primitives[0].targets)
+    assert all(g.accessors[t["POSITION"]].bufferView is None
+               and g.accessors[t["NORMAL"]].bufferView is None
+               for p in g.meshes[0].primitives for t in p.targets)
+    skin = g.meshes[0].primitives[0]
+    moved = [g.accessors[t["POSITION"]].sparse for t in skin.targets]
+    assert all(s is not None and 0 < s.count < 0.5 * g.accessors[skin.attributes.POSITION].count
+               for s in moved)  # sparse: each target moves a part of the skin
+    assert [p.material for p in g.meshes[0].primitives] == list(range(6))
+    extras = g.asset.extras["facelib"]
+    assert extras["n_frames"] == 12 and extras["fps"] == 25
+
+
+def test_speech_audio_is_copied_beside_and_named(tmp_path):
+    audio = Path(__file__).parents[2] / "examples" / "hello" / "hello.flac"
+    result = export_gltf(busy_stream(), tmp_path / "a.glb", audio=audio)
+    assert result.audio == tmp_path / "a.flac"
+    assert result.audio.read_bytes() == audio.read_bytes()
+    assert Gltf(result.path).g.asset.extras["facelib"]["audio"] == "a.flac"
+
+
+@pytest.mark.skipif(shutil.which("node") is None or not (WEB / "node_modules").exists(),
+                    reason="needs node and the npm packages (make setup)")
+def test_gltf_validator_reports_no_issue(exported):
+    result, _ = exported
+    run = subprocess.run(["node", str(WEB / "tools" / "validate.mjs"), str(result.path)],
+                         capture_output=True, text=True, check=False)
+    report = json.loads(run.stdout)
+    assert report["numErrors"] == 0 and report["numWarnings"] == 0, report["messages"][:5]
+
+
+def test_still_and_empty_streams(tmp_path):
+    from facelib import FapStream, ParameterError
+
+    result = export_gltf(FapStream.zeros(3, fps=25), tmp_path / "still.glb")
+    g = Gltf(result.path).g
+    assert result.targets == () and g.animations == [] and len(g.skins) == 1
+    with pytest.raises(ParameterError, match="no frames"):
+        export_gltf(FapStream.zeros(0, fps=25), tmp_path / "empty.glb")
+    with pytest.raises(ParameterError, match=r"\.glb"):
+        export_gltf(FapStream.zeros(3, fps=25), tmp_path / "x.gltf")
+
+
+def test_exports_are_lazy_names_of_facelib():
+    import facelib
+    import facelib.export as ex
+
+    assert facelib.export_gltf is ex.export_gltf and facelib.import_arkit is ex.import_arkit
+    assert {"export_gltf", "export_html", "export_arkit", "import_arkit"} <= set(facelib.__all__)
