@@ -43,7 +43,7 @@ lint: $(VENV)/.installed
 # Figures, not pass/fail: each benchmark prints what it measured.
 bench: $(VENV)/.installed
 	for b in engine_deform engine_setup render_speed gaze_simulate fdl_sandbox \
-		visemes_align_accuracy export_speed; do \
+		visemes_align_accuracy export_speed speech_long; do \
 		PYTHONPATH=. $(BIN)/python benchmarks/$$b.py || exit 1; done
 
 clean:

@@ -7,7 +7,12 @@ audio duration; the one-off model load is reported apart), for each sentence set
 lists 1-2 (the set the aligner's settings were tuned on) and two held-out sets, lists 3-4
 and 5-6, that no setting was chosen on. A change must help the held-out sets too.
 
-    PYTHONPATH=. .venv/bin/python benchmarks/visemes_align_accuracy.py [-v] [N_SENTENCES]
+    PYTHONPATH=. .venv/bin/python benchmarks/visemes_align_accuracy.py [-v] [--dtw] [N]
+
+``--dtw`` measures the DTW aligner (``facelib.speech.align_dtw``: espeak-ng's synthesized
+transcript warped onto the recording) instead. Its phones are IPA, so its phones are
+matched to Festival's by their viseme sequence (IPA and ARPAbet -> viseme id) rather than
+by label.
 
 ``-v`` adds the mean signed onset error per phone (positive: the aligner is late). Errors
 are whole milliseconds (aligner ms minus Festival's times rounded to ms, which are
@@ -31,8 +36,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from visemes_festival import synthesize
 
+from facelib.speech import align_dtw
 from facelib.speech.align import _decoder
 from facelib.visemes import align
+from facelib.visemes.ipa import ipa_viseme
+from facelib.visemes.tables import phone_viseme
 
 SENTENCES = (  # Harvard sentences (IEEE 1969), lists 1-2: the tuning set
     "The birch canoe slid on the smooth planks.",
@@ -106,7 +114,7 @@ SETS = {"tuning (lists 1-2)": SENTENCES, "held-out (lists 3-4)": HELD_OUT,
         "held-out (lists 5-6)": HELD_OUT_2}
 
 
-def measure(sentences: tuple[str, ...], tmp: Path, *, verbose: bool) -> None:
+def measure(sentences: tuple[str, ...], tmp: Path, *, verbose: bool, dtw: bool) -> None:
     """Align each sentence and print the onset statistics of the set."""
     errors: list[int] = []  # ms, aligner minus truth
     labels: list[str] = []
@@ -116,12 +124,16 @@ def measure(sentences: tuple[str, ...], tmp: Path, *, verbose: bool) -> None:
         wav = Path(tmp, f"s{k}.wav")
         truth = [p for p in synthesize(text, wav) if p[0] != "SIL"]
         t0 = time.perf_counter()
-        timeline = align(wav, text)
+        timeline = align_dtw(wav, text, lang="en") if dtw else align(wav, text)
         align_s += time.perf_counter() - t0
         audio_s += timeline.duration_ms / 1000
         got = [p for p in timeline.phones if p.label != "SIL"]
-        matcher = difflib.SequenceMatcher(
-            a=[p[0] for p in truth], b=[p.label for p in got], autojunk=False)
+        if dtw:
+            a = [phone_viseme(p[0]).visemes[0] for p in truth]
+            b = [ipa_viseme(p.label).visemes[0] for p in got]
+        else:
+            a, b = [p[0] for p in truth], [p.label for p in got]
+        matcher = difflib.SequenceMatcher(a=a, b=b, autojunk=False)
         total += len(truth)
         for block in matcher.get_matching_blocks():
             for i in range(block.size):
@@ -145,7 +157,7 @@ def measure(sentences: tuple[str, ...], tmp: Path, *, verbose: bool) -> None:
 
 
 def main() -> None:
-    args = [a for a in sys.argv[1:] if a != "-v"]
+    args = [a for a in sys.argv[1:] if a not in ("-v", "--dtw")]
     n = int(args[0]) if args else len(SENTENCES)
     t0 = time.perf_counter()
     _decoder()
@@ -153,7 +165,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for name, sentences in SETS.items():
             print(name)
-            measure(sentences[:n], Path(tmp), verbose="-v" in sys.argv)
+            measure(sentences[:n], Path(tmp), verbose="-v" in sys.argv, dtw="--dtw" in sys.argv)
 
 
 if __name__ == "__main__":

@@ -54,7 +54,8 @@ _LAZY = {
 
 
 def __getattr__(name: str) -> Any:
-    """Rendering, the viewer, plotting, the exports and face set-up load on first use."""
+    """Rendering, the viewer, plotting, the exports and face set-up import OpenGL,
+    matplotlib, pygltflib or trimesh: load them on first use."""
     if name in _LAZY:
         import importlib
 

@@ -22,7 +22,7 @@ from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.progress import ProgressCallback, progress_callback
 from facelib.sync import SyncRules, combine
-from facelib.visemes.animate import VisemeAnimation
+from facelib.visemes.animate import SpeechAudio, VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
 
 __all__ = ["Animation", "animate", "definition_line", "run_fdl"]
@@ -33,7 +33,10 @@ class Animation:
     """A storyboard turned into FAPs.
 
     faps: the synchronized stream (what is rendered or written to ``.fap``).
-    audio: the speech audio to play with it, or None.
+    audio: the speech audio file to play with it, or None.
+    speech_audio: synthesized speech (``.samples``, ``.sample_rate``) to play with it when
+        the storyboard's speech is text without a recording, or None.
+    loudness: ``(n_frames,) float32`` dBFS of the speech under each frame, or None.
     audio_offset: seconds into the animation at which the audio starts.
     storyboard: the storyboard it came from.
     tracks: each generator's own track (``"expressions"``, ``"visemes"``, ``"gaze"``),
@@ -49,6 +52,8 @@ class Animation:
     tracks: Mapping[str, FapTrack] = field(default_factory=dict)
     visemes: tuple[VisemeSpan, ...] | None = None
     gaze_events: tuple[GazeEvent, ...] = ()
+    speech_audio: SpeechAudio | None = None
+    loudness: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "tracks", MappingProxyType(dict(self.tracks)))
@@ -113,7 +118,8 @@ def _animate(
             f"storyboard {storyboard.path or '(in memory)'} lasts {storyboard.cues_end_ms} ms "
             f"= {n_frames} frames at {fps:g} fps, more than max_frames={max_frames}"
         )
-    speech = (visemes.animate(storyboard.speech, fps=fps, max_frames=max_frames)
+    speech = (visemes.animate(storyboard.speech, fps=fps, max_frames=max_frames,
+                              language=storyboard.language)
               if storyboard.speech else None)
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
@@ -146,6 +152,8 @@ def _animate(
         tracks={"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track},
         visemes=None if speech is None else speech.timeline,
         gaze_events=eyes.events,
+        speech_audio=None if speech is None else speech.audio,
+        loudness=None if speech is None else speech.loudness,
     )
 
 

@@ -64,7 +64,6 @@ def default_jobs() -> int:
 def render_job(job: RenderJob) -> BatchResult:
     """Render one :class:`RenderJob` in this process; errors become the result's ``error``."""
     from facelib.animation import run_fdl
-    from facelib.engine import load_face
     from facelib.mpeg4 import read_fap
     from facelib.rendering.frames import render
 
@@ -72,7 +71,7 @@ def render_job(job: RenderJob) -> BatchResult:
     try:
         source = (read_fap(job.source) if Path(job.source).suffix.lower() == ".fap"
                   else run_fdl(job.source, seed=job.seed))
-        out = render(source, face=load_face(job.face), out=job.output, width=job.width,
+        out = render(source, face=job.face, out=job.output, width=job.width,
                      height=job.height, fps=job.fps, progress=False)
     except FacelibError as exc:
         return BatchResult(job.source, None, time.perf_counter() - started, str(exc))

@@ -16,7 +16,7 @@ from facelib.errors import DataError, FacelibError
 
 __all__ = ["KINDS", "Entry", "catalog"]
 
-KINDS = ("expressions", "visemes", "behaviours", "voices")
+KINDS = ("expressions", "visemes", "behaviours", "voices", "languages")
 
 EXPRESSION_GALLERY = "docs/images/expressions.png"
 
@@ -29,16 +29,23 @@ class Entry:
     name: str
     description: str
     image: str = ""
+    languages: tuple[str, ...] = ()
 
 
-def catalog(kind: str) -> tuple[Entry, ...]:
-    """The entries of ``kind``, one of :data:`KINDS`, in library order."""
+def catalog(kind: str, *, lang: str | None = None) -> tuple[Entry, ...]:
+    """The entries of ``kind``, one of :data:`KINDS`, in library order; ``lang`` keeps only
+    the voices that speak a language whose code starts with it."""
     if kind not in KINDS:
         raise FacelibError(f"unknown kind {kind!r}; choose one of {', '.join(KINDS)}")
     listers: dict[str, Callable[[], tuple[Entry, ...]]] = {
         "expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
-        "voices": _voices}
-    return listers[kind]()
+        "voices": _voices, "languages": _languages}
+    entries = listers[kind]()
+    if lang and kind == "voices":
+        wanted = lang.lower()
+        entries = tuple(e for e in entries if any(
+            code.startswith(wanted) for code in e.languages))
+    return entries
 
 
 @cache
@@ -77,12 +84,16 @@ def _behaviours() -> tuple[Entry, ...]:
 
 
 def _voices() -> tuple[Entry, ...]:
-    import importlib
+    from facelib.speech.espeak import list_voices
 
-    speech = importlib.import_module("facelib.speech")
-    voices = getattr(speech, "voices", None)
-    if voices is None:
-        raise FacelibError("this facelib has no speech synthesis, so there are no voices: "
-                           "storyboards speak from recorded audio (say { ..., audio = ... }) "
-                           "or from text timed by phone durations")
-    return tuple(Entry(str(v.name), str(v.description)) for v in voices())
+    return tuple(
+        Entry(v.identifier, f"{v.name} ({', '.join(v.languages)}"
+                            + (f", {v.gender})" if v.gender else ")"), languages=v.languages)
+        for v in list_voices())
+
+
+def _languages() -> tuple[Entry, ...]:
+    from facelib.speech.synth import languages
+
+    return tuple(Entry(lang.lang, f"{lang.name} (espeak-ng voice {lang.voice}); e.g. "
+                                  f"{lang.sentence!r}") for lang in languages().values())

@@ -113,6 +113,22 @@ def _default_output(story: str, storyboard_output: Path | None, suffix: str) -> 
         return storyboard_output
 
 
+def _face_path(face: str | None) -> Path | None:
+    """``--face``: a face definition JSON, or the folder ``facelib face setup`` wrote."""
+    if face is None:
+        return None
+    path = Path(face)
+    return path / "face.json" if path.is_dir() else path
+
+
+def _face(face: str | None) -> Any:
+    """The Face ``--face`` names, else the default head."""
+    from facelib.engine import default_face, load_face
+
+    path = _face_path(face)
+    return default_face() if path is None else load_face(path)
+
+
 def _source(path: str, seed: int | None, console: Console) -> Any:
     """A storyboard's Animation, or a .fap file's stream."""
     if Path(path).suffix.lower() == ".fap":
@@ -301,8 +317,7 @@ def _render(args: argparse.Namespace, console: Console) -> int:
     results = render_batch(
         args.sources, args.output, jobs=args.jobs, suffix="." + args.format,
         width=args.width, height=args.height, fps=args.fps, seed=args.seed,
-        face=None if args.face is None else str(_face_path(args.face)),
-        progress=console.progress("batch", unit="files"),
+        face=_face_path(args.face), progress=console.progress("batch", unit="files"),
     )
     for result in results:
         if result.ok:
@@ -383,13 +398,16 @@ def _add_align(commands: Any) -> None:
     align.add_argument("--format", choices=("json", "tsv", "sb"), default="json",
                        help="the format written to stdout by -o - (default json)")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
+    align.add_argument("--lang", default="en",
+                       help="language of the speech (en: pocketsphinx; others: DTW against "
+                            "espeak-ng, which needs --text)")
     align.set_defaults(run=_align)
 
 
 def _align(args: argparse.Namespace, console: Console) -> int:
     import json
 
-    from facelib.visemes import align
+    from facelib.visemes import align, align_dtw
     from facelib.visemes.scripts import (
         timeline_to_json,
         timeline_to_sentence,
@@ -402,7 +420,12 @@ def _align(args: argparse.Namespace, console: Console) -> int:
     text = args.text
     if args.text_file is not None:
         text = Path(args.text_file).read_text(encoding="utf-8")
-    timeline = align(args.audio, text)
+    if args.lang.lower().startswith("en"):
+        timeline = align(args.audio, text)
+    elif text is None:
+        raise UsageError(f"aligning speech in {args.lang!r} needs its transcript (--text)")
+    else:
+        timeline = align_dtw(args.audio, text, lang=args.lang)
     formatted = {
         "json": lambda: json.dumps(timeline_to_json(timeline), indent=1) + "\n",
         "tsv": lambda: timeline_to_tsv(timeline),
@@ -422,13 +445,14 @@ def _add_list(commands: Any) -> None:
         "list", parents=[_COMMON],
         help="list the names a storyboard may use: " + ", ".join(KINDS))
     listing.add_argument("kind", choices=KINDS)
+    listing.add_argument("--lang", help="voices: only those of this language (e.g. de)")
     listing.set_defaults(run=_list)
 
 
 def _list(args: argparse.Namespace, console: Console) -> int:
     from facelib.catalog import catalog
 
-    entries = catalog(args.kind)
+    entries = catalog(args.kind, lang=args.lang)
     width = max((len(e.name) for e in entries), default=0)
     for entry in entries:
         extra = f"  [{entry.image}]" if entry.image else ""
@@ -580,10 +604,9 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     if args.render:
         if video is None:
             raise FacelibError("--render needs a video source (the mirror shows it)")
-        from facelib.engine import load_face
         from facelib.tracking.mirror import render_mirror
 
-        out = render_mirror(video, result.stream, args.render, face=load_face(args.face),
+        out = render_mirror(video, result.stream, args.render, face=_face(args.face),
                             landmarks=landmarks if args.show_landmarks else None)
         console.status(f"wrote {out}")
     return EXIT_OK
@@ -624,7 +647,6 @@ def _export(args: argparse.Namespace, console: Console) -> int:
     import numpy as np
 
     from facelib import export
-    from facelib.engine import default_face, load_face
 
     if args.output is None and args.html is None:
         raise UsageError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
@@ -632,7 +654,7 @@ def _export(args: argparse.Namespace, console: Console) -> int:
     if args.output is not None:
         _check_suffix(args.output, (".csv", ".json") if args.arkit else
                       (".glb", ".csv", ".json"), "export")
-    face = default_face() if args.face is None else load_face(args.face)
+    face = _face(args.face)
     source = _source(args.source, args.seed, console)
     if args.output is not None:
         suffix = Path(args.output).suffix.lower()
@@ -666,30 +688,16 @@ def _import_arkit(args: argparse.Namespace, console: Console) -> int:
     return EXIT_OK
 
 
-_COMMON = argparse.ArgumentParser(add_help=False)
-_COMMON.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
-                     help="print only errors")
-_COMMON.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
-                     help="also print log messages, progress of every stage and tracebacks")
-
-# -- face set-up -------------------------------------------------------------------------
-
-
-def _face_path(face: str | None) -> Path | None:
-    """``--face``: a face definition JSON, or the folder ``facelib face setup`` wrote."""
-    if face is None:
-        return None
-    path = Path(face)
-    return path / "face.json" if path.is_dir() else path
+# -- face setup --------------------------------------------------------------------------
 
 
 def _add_face(commands: Any) -> None:
     face = commands.add_parser("face", help="make your own head mesh animatable",
                                parents=[_COMMON])
-    face_commands = face.add_subparsers(dest="face_command", metavar="ACTION")
+    face_commands = face.add_subparsers(dest="face_command", metavar="ACTION", required=True)
     setup = face_commands.add_parser(
-        "setup", parents=[_COMMON],
-        help="transfer the default face definition onto a head mesh (docs/own-head.md)")
+        "setup", help="transfer the default face definition onto a head mesh",
+        parents=[_COMMON])
     setup.add_argument("mesh", help="head mesh: .obj, .ply, .glb/.gltf, .off or .stl")
     setup.add_argument("--landmarks", help="JSON of feature point -> vertex index or [x, y, z]")
     setup.add_argument("--auto", action="store_true",
@@ -735,7 +743,8 @@ def _face_setup(args: argparse.Namespace, console: Console) -> int:
     if bad:
         raise UsageError(f"--part {bad[0]!r} must be PART=OBJECT, e.g. eye_l=LeftEye")
     started = time.perf_counter()
-    mesh = load_head_mesh(args.mesh, parts=dict(item.split("=", 1) for item in args.part))
+    parts = dict(item.split("=", 1) for item in args.part)
+    mesh = load_head_mesh(args.mesh, parts=parts)
     landmarks: Any = args.landmarks
     axes = {"up": args.up, "forward": args.forward}
     found = None
@@ -752,33 +761,40 @@ def _face_setup(args: argparse.Namespace, console: Console) -> int:
                      source=f"facelib face setup {Path(args.mesh).name}")
     if found is not None:
         _write_found(found, Path(args.output), console)
-    _report_setup(args.mesh, len(mesh.vertices), result, console)
+    _report_setup(args.mesh, mesh, result, console)
     console.status(f"wrote {out} in {time.perf_counter() - started:.1f} s")
     return EXIT_OK
 
 
-def _report_setup(mesh: str, n_vertices: int, result: Any, console: Console) -> None:
+def _report_setup(name: str, mesh: Any, result: Any, console: Console) -> None:
     import numpy as np
 
     from facelib.mpeg4.tables import FAPU_SCALE
 
     face = result.face
-    console.status(f"mesh:      {mesh} ({n_vertices} vertices, unit {result.unit})")
+    console.status(f"mesh:      {name} ({len(mesh.vertices)} vertices, unit {result.unit})")
     if not np.allclose(result.rotation, np.eye(3)):
         console.status("oriented:  turned upright (+y up, looking along +z)")
     console.status(f"landmarks: {len(result.landmarks)}, off the surface by at most "
                    f"{result.residual.max() * 1000:.2f} mm")
     own = [p for p in face.parts if p not in result.carried]
     console.status(f"parts:     {', '.join(own)} from the mesh"
-                   + (f"; {', '.join(result.carried)} warped into place from the default "
-                      "head" if result.carried else ""))
+                   + (f"; {', '.join(result.carried)} warped into place from the default head"
+                      if result.carried else ""))
     console.status("FAPU0 (mm): " + "  ".join(f"{k} {v * FAPU_SCALE * 1000:.2f}"
-                                              for k, v in face.fapu.items() if k != "AU"))
+                                             for k, v in face.fapu.items() if k != "AU"))
 
+
+_COMMON = argparse.ArgumentParser(add_help=False)
+_COMMON.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+                     help="print only errors")
+_COMMON.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                     help="also print log messages, progress of every stage and tracebacks")
 
 _COMMANDS: tuple[Callable[[Any], None], ...] = (
     _add_info, _add_check, _add_run, _add_render, _add_view, _add_plot, _add_align,
-    _add_list, _add_dataset, _add_evaluate, _add_track, _add_export, _add_face,
+    _add_list, _add_dataset, _add_evaluate, _add_track, _add_export,
+    _add_face,
 )
 
 

@@ -83,13 +83,22 @@ class VisemeCue:
 @dataclass(frozen=True, slots=True)
 class SpeechSpec:
     """What the character says, starting at ``start_ms``: audio and/or transcript text, or a
-    stored viseme script (used as it is, without speech processing)."""
+    stored viseme script (used as it is, without speech processing).
+
+    ``lang`` is the language (None: the storyboard's); ``voice``, ``rate`` (1.0 = 175 words
+    per minute) and ``pitch`` (0-100, 50 = the voice's own) shape synthesized speech for
+    text without audio (``voice`` None: the language's espeak-ng voice).
+    """
 
     audio: Path | None = None
     text: str | None = None
     visemes: tuple[VisemeCue, ...] | None = None
     start_ms: int = 0
     origin: Origin | None = None
+    lang: str | None = None
+    voice: str | None = None
+    rate: float = 1.0
+    pitch: float = 50.0
 
 
 def _frozen_map(value: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -116,6 +125,8 @@ class Storyboard:
         Mixes of expressions the storyboard itself defines are resolved at load time.
     output: where the storyboard asks the ``.fap`` to go, or None.
     face: the face definition JSON the storyboard is played on, or None (the default head).
+    language: the storyboard's language (``language = "pt"``), used by speech that names
+        none; None means English.
     """
 
     path: Path | None = None
@@ -129,6 +140,7 @@ class Storyboard:
     output: Path | None = None
     expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     face: Path | None = None
+    language: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))

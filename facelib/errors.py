@@ -125,5 +125,10 @@ class SpeechWarning(FacelibWarning):
     """An alignment succeeded but looks implausible (named word, reason)."""
 
 
+class PronunciationWarning(SpeechWarning):
+    """Words could not be pronounced as written (not in the dictionary: guessed from their
+    spelling); the message names every one."""
+
+
 class TrackingWarning(FacelibWarning):
     """Tracking went on but lost the face in some frames, or saw several faces (names them)."""

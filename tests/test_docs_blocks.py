@@ -3,7 +3,8 @@
 Storyboards (lua) go through `facelib check` and `facelib run`; Python blocks run in a fresh
 interpreter; shell lines that call `facelib` run as commands. Each runs in a scratch folder
 holding the example media, with `examples/` and `tests/` linked in so repository paths
-resolve. JSON blocks illustrate a schema with placeholders and are not run.
+resolve. JSON blocks illustrate a schema with placeholders and are not run, and so is a block
+right after a ``<!-- not run: reason -->`` line (it needs files a reader makes first).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from facelib.cli import main
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.DOTALL | re.MULTILINE)
+NOT_RUN = "<!-- not run:"
 MEDIA = [*(ROOT / "examples" / "hastalavista").iterdir(),
          *(ROOT / "examples" / "hello").iterdir()]
 
@@ -33,7 +35,8 @@ def blocks(language: str) -> list[tuple[str, str]]:
     for page in PAGES:
         text = page.read_text(encoding="utf-8")
         for match in FENCE.finditer(text):
-            if match.group(1) == language:
+            before = text[: match.start()].rstrip().rsplit("\n", 1)[-1]
+            if match.group(1) == language and not before.startswith(NOT_RUN):
                 line = text[: match.start()].count("\n") + 1
                 found.append((f"{page.relative_to(ROOT)}:{line}", match.group(2)))
     return found

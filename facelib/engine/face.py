@@ -20,7 +20,7 @@ dilation) and 47 (tongue roll) do not move this mesh.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from facelib.checks import check_count
 from facelib.engine import rigid
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
@@ -263,6 +264,21 @@ class Face:
         stream = apply_high_level(stream)  # FAP 1/2 from other tools' files
         return self._deform(np.asarray(stream.values, dtype=np.float32))
 
+    def deform_chunks(
+        self, stream: FapStream, *, frames: int = 256
+    ) -> Iterator[tuple[int, np.ndarray]]:
+        """:meth:`deform` in pieces: yields ``(first_frame, (n, V, 3) float32)`` for
+        consecutive blocks of at most ``frames`` frames, so a long stream never needs all its
+        vertices at once (memory: ``frames x V x 3`` floats). The blocks, stacked, equal
+        ``deform(stream)`` bit for bit."""
+        if not isinstance(stream, FapStream):
+            raise ParameterError(f"deform_chunks() takes a FapStream, not {type(stream).__name__}")
+        frames = check_count("frames", frames, low=1)
+        values = np.asarray(stream.values, dtype=np.float32)
+        active = self._active(values)
+        for first in range(0, values.shape[0], frames):
+            yield first, self._deform(values[first:first + frames], active)
+
     def deform_frame(self, values: np.ndarray) -> np.ndarray:
         """Vertex positions for one frame of 84 FAP values: ``(84,) -> (V, 3) float32``."""
         values = np.asarray(values, dtype=np.float32)
@@ -272,10 +288,15 @@ class Face:
             raise ParameterError("deform_frame() got a non-finite FAP value")
         return self._deform(values[None, :])[0]
 
-    def _deform(self, f: np.ndarray) -> np.ndarray:
+    def _active(self, f: np.ndarray) -> np.ndarray:
+        """Indices of the FAPs that move a vertex and are non-zero somewhere in ``f``."""
+        return np.flatnonzero(np.any(self._dense != 0, axis=1) & np.any(f != 0, axis=0))
+
+    def _deform(self, f: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
         n, nv = f.shape[0], self.n_vertices
         out = np.empty((n, nv, 3), np.float32)
-        active = np.flatnonzero(np.any(self._dense != 0, axis=1) & np.any(f != 0, axis=0))
+        if active is None:
+            active = self._active(f)
         # frames go through in small blocks so that every pass stays in the CPU cache
         buf = np.empty((_BLOCK, nv, 3), np.float32)
         for a in range(0, n, _BLOCK):

@@ -55,7 +55,8 @@ FUNCTIONS: Mapping[str, StoryboardFunction] = MappingProxyType({
     f.name: f
     for f in (
         StoryboardFunction(
-            "say", ("text", "transcript", "audio", "visemes", "at"),
+            "say", ("text", "transcript", "audio", "visemes", "at", "lang", "voice", "rate",
+                    "pitch"),
             'say { "Hello.", audio = "hello.wav", at = 0.5 }', modern.read_say,
             takes_string=True,
         ),
@@ -85,6 +86,7 @@ SETTINGS: Mapping[str, str] = MappingProxyType({
     "output": 'the .fap file to write, relative to the storyboard, or "none"',
     "face": "the face definition JSON to play on, relative to the storyboard "
             "(e.g. made by facelib face setup; default: the bundled head)",
+    "language": 'language of speech that names none ("pt", "de", ...; default English)',
 })  # fmt: skip
 """Globals that set storyboard options, with what each means."""
 

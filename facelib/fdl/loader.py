@@ -3,11 +3,12 @@
 One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts, or the
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
-``fps`` (default 25), ``seed`` (default 0), ``output`` and ``face`` (a face definition
-JSON, e.g. one made by ``facelib face setup``) set the storyboard options; every
-name is declared in :mod:`facelib.fdl.functions`. Each syntax converts to cues in its own
-module (:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs
-the script, reads the settings and merges the two.
+``fps`` (default 25), ``seed`` (default 0), ``output``, ``face`` (a face definition JSON,
+e.g. one made by ``facelib face setup``) and ``language`` (default English; the language of
+speech that names none) set the storyboard options; every name is declared in
+:mod:`facelib.fdl.functions`. Each syntax converts to cues in its own module
+(:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs the
+script, reads the settings and merges the two.
 """
 
 from __future__ import annotations
@@ -194,6 +195,10 @@ def _build(
     gaze = thesis_cues.gaze_cues(lists.get("eyes"))
     speech = _speech(fdl, fdl_line, lists.get("Sentence"), parts, ctx)
     output = _output(chunk, fdl, fdl_line, ctx)
+    language = _global(chunk, "language")
+    if language is not None and not (isinstance(language, str) and language.strip()):
+        raise FdlError(f"language must be a language code like \"pt\"; got {language!r}",
+                       path=name, line=_line(text, "language"))
     if output is not None:
         _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
     face_value = _global(chunk, "face")
@@ -202,6 +207,7 @@ def _build(
     return Storyboard(
         path=file,
         fps=fps,
+        language=language.strip() if isinstance(language, str) else None,
         seed=seed,
         speech=speech,
         expressions=_by_start((*expressions, *modern_cues.expression_cues(

@@ -36,6 +36,7 @@ __all__ = [
     "read_show",
 ]
 
+_SAY_RANGES = {"rate": (0.5, 2.5), "pitch": (0.0, 100.0)}
 _MAX_FAP_VALUE = 100_000.0
 
 
@@ -63,6 +64,10 @@ class DraftSpeech:
     transcript: str | None = None
     audio: str | None = None
     visemes: tuple[tuple[str, int, int | None], ...] | None = None
+    lang: str | None = None
+    voice: str | None = None
+    rate: float = 1.0
+    pitch: float = 50.0
 
 
 @dataclass(slots=True)
@@ -231,9 +236,15 @@ def read_say(
         raise FdlError(
             "say: give either the text or a transcript file, not both", path=ctx.path, line=line
         )
-    for key in ("text", "transcript", "audio"):
+    for key in ("text", "transcript", "audio", "lang", "voice"):
         if key in f and not isinstance(f[key], str):
             raise FdlError(f"say: {key} must be a string; got {f[key]!r}", path=ctx.path, line=line)
+    for key, (low, high) in _SAY_RANGES.items():
+        value = f.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
+                                  or not low <= value <= high):
+            raise FdlError(f"say: {key} must be a number from {low:g} to {high:g}; got {value!r}",
+                           path=ctx.path, line=line)
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
@@ -244,6 +255,10 @@ def read_say(
         transcript=f.get("transcript"),
         audio=f.get("audio"),
         visemes=visemes,
+        lang=f.get("lang"),
+        voice=f.get("voice"),
+        rate=float(f.get("rate", 1.0)),
+        pitch=float(f.get("pitch", 50.0)),
     )
 
 

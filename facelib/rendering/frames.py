@@ -9,6 +9,7 @@ the headless platform chosen by :mod:`facelib.rendering.platform`.
 from __future__ import annotations
 
 import os
+import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -22,7 +23,8 @@ from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import open_writer, save_png
 
-__all__ = ["face_or_default", "iter_frames", "render", "render_still", "save_png", "stream_of"]
+__all__ = ["face_or_default", "iter_frames", "render", "render_still", "save_png",
+           "speech_audio_file", "stream_of"]
 
 _CHUNK = 32  # frames deformed at once: bounds memory to 32 x V x 3 floats
 
@@ -45,6 +47,20 @@ def stream_of(source: FapStream | HasFaps) -> tuple[FapStream, Path | None, floa
     return stream, None if audio is None else Path(audio), float(
         getattr(source, "audio_offset", 0.0) or 0.0
     )
+
+
+def speech_audio_file(source: object, path: Path) -> Path | None:
+    """Write ``source.speech_audio`` (synthesized speech: ``.samples`` ``(n,)`` float in
+    [-1, 1], ``.sample_rate`` Hz) to ``path`` as 16-bit WAV and return it; None when the
+    source has none."""
+    speech = getattr(source, "speech_audio", None)
+    if speech is None:
+        return None
+    import soundfile
+
+    soundfile.write(str(path), np.asarray(speech.samples), int(speech.sample_rate),
+                    subtype="PCM_16")
+    return path
 
 
 def face_or_default(face: Deformable | str | os.PathLike[str] | None,
@@ -128,16 +144,17 @@ def render(
         return _one_png(face, stream, out, width=width, height=height, background=background)
     if out is None and audio is not None and source_audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
-    with FaceRenderer(face, width=width, height=height, background=background) as renderer:
-        frames = iter_frames(renderer, face, stream, progress=progress)
-        if out is None:
-            result = np.empty((stream.n_frames, renderer.height, renderer.width, 3), np.uint8)
-            for i, image in enumerate(frames):
-                result[i] = image
-            return result
-        mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
-        return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
-                      audio_offset=offset)
+    with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
+        if audio is None and out is not None and Path(out).suffix.lower() == ".mp4":
+            audio = speech_audio_file(source, Path(folder) / "speech.wav")
+        with FaceRenderer(face, width=width, height=height, background=background) as renderer:
+            frames = iter_frames(renderer, face, stream, progress=progress)
+            if out is None:
+                return np.stack(list(frames)) if stream.n_frames else np.empty(
+                    (0, renderer.height, renderer.width, 3), np.uint8)
+            mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
+            return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
+                          audio_offset=offset)
 
 
 def _one_png(

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from functools import cache
+from itertools import pairwise
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
-from facelib.errors import ParameterError, SpeechError, SpeechWarning
+from facelib.errors import ParameterError, PronunciationWarning, SpeechError, SpeechWarning
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.pronounce import model_dir, pronounce, tokenize
 from facelib.speech.tables import alignment_settings, phone_durations
@@ -28,14 +28,16 @@ from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 __all__ = ["align"]
 
 OnImplausible = Literal["warn", "raise", "ignore"]
+LONG_MS = 60_000
+"""Recordings longer than this (ms) are aligned sentence by sentence (bounded memory)."""
 _NOISE = {"SIL", "NSN", "SPN", "<sil>", "<s>", "</s>", "[NOISE]", "+NSN+", "+SPN+"}
 _PHONE_LOOP = "_facelib_phone_loop"
 
 
-@cache
 def _decoder(*, wide: bool = False) -> Any:
-    """One pocketsphinx decoder per process and beam setting (loading the model takes
-    about a second); ``wide`` gives the fallback with the wide beams of alignment.json."""
+    """A new pocketsphinx decoder (``wide``: with the wide beams of alignment.json). Not
+    kept: a decoder holds on to the memory of its last search (gigabytes after a long
+    recording), so each alignment loads the model afresh (about a second) and frees it."""
     try:
         from pocketsphinx import Decoder
     except ImportError as exc:
@@ -89,18 +91,69 @@ def align(
     samples = load_speech(audio, sample_rate=sample_rate)
     duration_ms = round(samples.size * 1000 / ALIGN_RATE)
     settings = alignment_settings()
-    pcm = to_pcm16(samples, pad_ms=settings["pad_ms"])
     where = audio if not isinstance(audio, np.ndarray) else None
     if text is None:
-        phones = _phone_loop(pcm, duration_ms)
+        phones = _phone_loop(to_pcm16(samples, pad_ms=settings["pad_ms"]), duration_ms)
         return PhoneTimeline(phones, (), "phone-loop", duration_ms)
-    phones, words, problems = _forced(pcm, text, duration_ms, where)
+    if duration_ms > LONG_MS:
+        phones, words, problems, guessed = _forced_in_pieces(samples, text, where)
+    else:
+        pcm = to_pcm16(samples, pad_ms=settings["pad_ms"])
+        phones, words, problems, guessed = _forced(pcm, text, duration_ms, where, {})
+    if guessed:
+        warnings.warn(f"not in the pronunciation dictionary, pronounced as spelt: "
+                      f"{', '.join(repr(w) for w in guessed)}", PronunciationWarning,
+                      stacklevel=2)
     if problems and on_implausible != "ignore":
         message = "implausible alignment: " + "; ".join(problems)
         if on_implausible == "raise":
             raise SpeechError(message, path=where)
         warnings.warn(message, SpeechWarning, stacklevel=2)
     return PhoneTimeline(phones, words, "forced", duration_ms)
+
+
+def _forced_in_pieces(
+    samples: np.ndarray, text: str, where: str | Path | None
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str], list[str]]:
+    """Forced alignment of a long recording one sentence at a time: the sentences are found
+    in the audio by DTW against the synthesized transcript (:func:`sentence_spans`), the
+    audio is cut halfway through the pauses between them, and each piece is aligned by
+    pocketsphinx with its sentence; the results are stitched. Memory stays that of one
+    sentence; time grows linearly."""
+    from facelib.speech.dtw import sentence_spans
+
+    duration_ms = round(samples.size * 1000 / ALIGN_RATE)
+    spans = sentence_spans(samples, text, lang="en-us")
+    cuts = [0] + [(a.end_ms + b.start_ms) // 2 for a, b in pairwise(spans)]
+    cuts.append(duration_ms)
+    pad = alignment_settings()["pad_ms"]
+    decoders: dict[bool, Any] = {}
+    phones: list[Span] = []
+    words: list[Span] = []
+    problems: list[str] = []
+    guessed: list[str] = []
+    for span, start, end in zip(spans, cuts[:-1], cuts[1:], strict=True):
+        piece = samples[start * ALIGN_RATE // 1000:end * ALIGN_RATE // 1000]
+        if end - start < 100 or not tokenize_words(span.label):
+            continue
+        p, w, trouble, oov = _forced(to_pcm16(piece, pad_ms=pad), span.label, end - start,
+                                     where, decoders)
+        for s in p:
+            _append(phones, s.label, s.start_ms + start, s.end_ms + start)
+        for s in w:
+            _append(words, s.label, s.start_ms + start, s.end_ms + start)
+        problems += trouble
+        guessed += [g for g in oov if g not in guessed]
+    decoders.clear()
+    return _cover(phones, duration_ms), _cover(words, duration_ms), problems, guessed
+
+
+def tokenize_words(text: str) -> list[str]:
+    """The words of ``text`` as the aligner sees them (no punctuation); empty if none."""
+    try:
+        return [t for t in tokenize(text) if t[0].isalpha()]
+    except SpeechError:
+        return []
 
 
 def _decode(decoder: Any, pcm: bytes) -> None:
@@ -110,23 +163,32 @@ def _decode(decoder: Any, pcm: bytes) -> None:
 
 
 def _forced(
-    pcm: bytes, text: str, duration_ms: int, where: str | Path | None
-) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
+    pcm: bytes, text: str, duration_ms: int, where: str | Path | None,
+    decoders: dict[bool, Any],
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str], list[str]]:
+    """Forced alignment of one utterance; ``decoders`` (wide beams? -> decoder) holds the
+    decoders made so far in this call, so pieces of one recording share them."""
     words = [t for t in tokenize(text) if t[0].isalpha()]
+
+    def decoder(*, wide: bool) -> Any:
+        if wide not in decoders:
+            decoders[wide] = _decoder(wide=wide)
+        return decoders[wide]
+
     try:
-        return _forced_with(_decoder(), pcm, words, text=text, duration_ms=duration_ms,
+        return _forced_with(decoder(wide=False), pcm, words, text=text, duration_ms=duration_ms,
                             where=where)
     except SpeechError:
         # The default beams sometimes prune every path of a correct transcript (seen on
         # espeak-ng speech); the wide beams find it, at some cost in boundary precision.
-        return _forced_with(_decoder(wide=True), pcm, words, text=text,
+        return _forced_with(decoder(wide=True), pcm, words, text=text,
                             duration_ms=duration_ms, where=where)
 
 
 def _forced_with(
     decoder: Any, pcm: bytes, words: list[str], *, text: str, duration_ms: int,
     where: str | Path | None,
-) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str]]:
+) -> tuple[tuple[Span, ...], tuple[Span, ...], list[str], list[str]]:
     guessed = []
     for word in words:
         if decoder.lookup_word(word) is None:
@@ -169,7 +231,8 @@ def _forced_with(
             problems += _check_word(name, word_phones, settings, name in guessed, final=final)
         else:
             problems += _check_pause(word_spans, word_phones, settings)
-    return _cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems
+    return (_cover(phone_spans, duration_ms), _cover(word_spans, duration_ms), problems,
+            guessed)
 
 
 def _shift_boundaries(

@@ -3,8 +3,10 @@ while a writer drafts a storyboard before the voice is recorded."""
 
 from __future__ import annotations
 
+import warnings
+
 from facelib.checks import check_number
-from facelib.errors import MissingExtraError, SpeechError
+from facelib.errors import MissingExtraError, PronunciationWarning, SpeechError
 from facelib.speech.pronounce import letter_to_sound, pronounce, tokenize
 from facelib.speech.tables import DurationRules, duration_rules, phone_durations
 from facelib.speech.tables import pauses as pause_table
@@ -13,11 +15,14 @@ from facelib.speech.timeline import SILENCE, PhoneTimeline, Span
 __all__ = ["timeline_from_text"]
 
 
-def _phones_of(word: str) -> tuple[str, ...]:
+def _phones_of(word: str, guessed: list[str]) -> tuple[str, ...]:
     try:
-        return pronounce(word)[0]
+        phones, known = pronounce(word)
     except MissingExtraError:  # no dictionary without the speech extra: spell it out
-        return letter_to_sound(word)
+        phones, known = letter_to_sound(word), False
+    if not known:
+        guessed.append(word)
+    return phones
 
 
 def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
@@ -28,6 +33,7 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
     pauses = pause_table()
     rules = duration_rules()
     tokens = tokenize(text)
+    guessed: list[str] = []
     phones: list[Span] = []
     words: list[Span] = []
     t = round(pauses["edge"] / rate)
@@ -39,7 +45,8 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
         following = tokens[k + 1] if k + 1 < len(tokens) else None
         pause = pauses.get(following, 0) if following else pauses["edge"]
         start = t
-        for phone, ms in _word_durations(token, final=bool(pause), rate=rate, rules=rules):
+        for phone, ms in _word_durations(_phones_of(token, guessed), token, final=bool(pause),
+                                         rate=rate, rules=rules):
             phones.append(Span(phone, t, t + ms))
             t += ms
         words.append(Span(token, start, t))
@@ -48,19 +55,23 @@ def timeline_from_text(text: str, *, rate: float = 1.0) -> PhoneTimeline:
             phones.append(Span(SILENCE, t, t + ms))
             words.append(Span(SILENCE, t, t + ms))
             t += ms
+    if guessed:
+        warnings.warn(f"not in the pronunciation dictionary, pronounced as spelt: "
+                      f"{', '.join(repr(w) for w in dict.fromkeys(guessed))}", PronunciationWarning,
+                      stacklevel=2)
     phones = _join_silences(phones)
     words = _join_silences(words)
     return PhoneTimeline(tuple(phones), tuple(words), "durations", t)
 
 
 def _word_durations(
-    word: str, *, final: bool, rate: float, rules: DurationRules
+    word_phones: tuple[str, ...], word: str, *, final: bool, rate: float, rules: DurationRules
 ) -> list[tuple[str, int]]:
-    """(phone, ms) of ``word``: each phone's mean duration, shortened if it is the vowel of
-    a short one-vowel word, lengthened if it ends a phrase (``final``), never below the
-    phone's minimum, scaled by ``rate`` and floored at ``rules.floor_ms``."""
+    """(phone, ms) of ``word`` spoken as ``word_phones``: each phone's mean duration,
+    shortened if it is the vowel of a short one-vowel word, lengthened if it ends a phrase
+    (``final``), never below the phone's minimum, scaled by ``rate`` and floored at
+    ``rules.floor_ms``."""
     table = phone_durations()
-    word_phones = _phones_of(word)
     n_vowels = sum(p in rules.vowels for p in word_phones)
     out = []
     for i, phone in enumerate(word_phones):

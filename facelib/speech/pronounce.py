@@ -10,19 +10,31 @@ from pathlib import Path
 from types import MappingProxyType
 
 from facelib.errors import MissingExtraError, SpeechError
+from facelib.speech.normalize import spell_numbers, to_ascii
 from facelib.speech.tables import letter_to_sound_rules
 
-__all__ = ["dictionary", "letter_to_sound", "pronounce", "tokenize"]
+__all__ = ["dictionary", "letter_to_sound", "normalize_english", "pronounce", "tokenize"]
 
 _DIGITS = ("zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine")
 _TOKEN = re.compile(r"[a-z]+(?:'[a-z]+)*|[0-9]|[,;:.!?]")
 
 
+def normalize_english(text: str) -> str:
+    """``text`` ready for the English dictionary: numbers spelt out by num2words ("2026" ->
+    "twenty twenty-six") and letters transliterated by anyascii ("José" -> "Jose"). Without
+    the ``speech`` extra the text is returned as it is (digits are then spelt one by one)."""
+    try:
+        return to_ascii(spell_numbers(text, lang="en"))
+    except MissingExtraError:
+        return text
+
+
 def tokenize(text: str) -> list[str]:
-    """Lower-case words of ``text`` (digits spelt one by one), with the punctuation marks
-    ``, ; : . ! ?`` kept as their own tokens. Raises :class:`SpeechError` for a transcript
-    without words."""
-    tokens = [_DIGITS[int(t)] if t.isdigit() else t for t in _TOKEN.findall(text.lower())]
+    """Lower-case words of English ``text`` after :func:`normalize_english` (remaining
+    digits spelt one by one), with the punctuation marks ``, ; : . ! ?`` kept as their own
+    tokens. Raises :class:`SpeechError` for a transcript without words."""
+    plain = normalize_english(text).lower().replace("-", " ")
+    tokens = [_DIGITS[int(t)] if t.isdigit() else t for t in _TOKEN.findall(plain)]
     if not any(t[0].isalpha() for t in tokens):
         raise SpeechError(f"transcript {text!r} has no words")
     return tokens

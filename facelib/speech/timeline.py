@@ -11,18 +11,21 @@ from typing import Literal
 
 from facelib.errors import ParameterError
 
-__all__ = ["SILENCE", "PhoneTimeline", "Source", "Span", "check_interval"]
+__all__ = ["SILENCE", "Alphabet", "PhoneTimeline", "Source", "Span", "check_interval"]
 
 SILENCE = "SIL"
 """The phone label of silence (and of the acoustic model's noise phones after cleaning)."""
 
-Source = Literal["forced", "phone-loop", "durations", "script"]
+Source = Literal["forced", "phone-loop", "durations", "script", "synthesis", "dtw"]
+Alphabet = Literal["arpabet", "ipa"]
+"""How phone labels are written: ARPAbet (pocketsphinx, the duration model) or IPA
+(espeak-ng synthesis and the alignment built on it)."""
 
 
 @dataclass(frozen=True, slots=True)
 class Span:
-    """A labelled interval ``[start_ms, end_ms)``: a phone (ARPAbet without stress, silence
-    as ``"SIL"``) or a word (lower case, silence as ``"SIL"``)."""
+    """A labelled interval ``[start_ms, end_ms)``: a phone (ARPAbet without stress or IPA,
+    silence as ``"SIL"``) or a word (lower case, silence as ``"SIL"``)."""
 
     label: str
     start_ms: int
@@ -43,12 +46,15 @@ class Span:
 class PhoneTimeline:
     """What is said when: ``phones`` and ``words`` (spans in time order), how it was found
     (``source``: ``"forced"`` alignment, ``"phone-loop"`` recognition, ``"durations"`` of the
-    text-only model) and ``duration_ms``, the length of the speech."""
+    text-only model, ``"synthesis"`` by espeak-ng, ``"dtw"`` alignment to a synthesized
+    transcript), ``duration_ms``, the length of the speech, and ``alphabet``, how the phone
+    labels are written (``"arpabet"`` or ``"ipa"``)."""
 
     phones: tuple[Span, ...]
     words: tuple[Span, ...]
     source: Source
     duration_ms: int
+    alphabet: Alphabet = "arpabet"
 
 
 def check_interval(label: str, start_ms: int, end_ms: int) -> None:

@@ -7,10 +7,13 @@ FAP curves, viseme scripts.
 
 from facelib.errors import SpeechWarning
 from facelib.visemes.animate import (
+    SpeechAudio,
     VisemeAnimation,
     align,
+    align_dtw,
     animate,
     speech_timeline,
+    synthesize,
     timeline_from_text,
 )
 from facelib.visemes.coarticulation import blend, driven_faps, envelope
@@ -37,11 +40,13 @@ __all__ = [
     "N_VISEMES",
     "SILENCE",
     "Span",
+    "SpeechAudio",
     "SpeechTimeline",
     "SpeechWarning",
     "VisemeAnimation",
     "VisemeSpan",
     "align",
+    "align_dtw",
     "animate",
     "blend",
     "driven_faps",
@@ -50,6 +55,7 @@ __all__ = [
     "phones_to_visemes",
     "script_name",
     "speech_timeline",
+    "synthesize",
     "timeline_from_json",
     "timeline_from_text",
     "timeline_to_json",

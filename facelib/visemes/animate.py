@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,11 +11,17 @@ import numpy as np
 
 from facelib.checks import check_fps, check_number
 from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
-from facelib.errors import SpeechError
+from facelib.errors import MissingExtraError, SpeechError, SpeechWarning
 from facelib.mpeg4.track import FapTrack
 from facelib.speech import align as align_phones
 from facelib.speech import timeline_from_text as phones_from_text
 from facelib.speech.align import OnImplausible
+from facelib.speech.audio import ALIGN_RATE, load_speech
+from facelib.speech.dtw import align_dtw as align_phones_dtw
+from facelib.speech.loudness import FLOOR_DB, phone_loudness
+from facelib.speech.synth import DEFAULT_LANGUAGE
+from facelib.speech.synth import synthesize as synthesize_speech
+from facelib.speech.timeline import PhoneTimeline
 from facelib.visemes.coarticulation import (
     blend,
     driven_faps,
@@ -26,7 +33,17 @@ from facelib.visemes.mapping import with_visemes
 from facelib.visemes.scripts import visemes_from_cues
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
-__all__ = ["VisemeAnimation", "align", "animate", "speech_timeline", "timeline_from_text"]
+__all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate",
+           "speech_timeline", "synthesize", "timeline_from_text"]
+
+
+@dataclass(frozen=True, eq=False)
+class SpeechAudio:
+    """Speech audio to play with the animation: ``samples`` ``(n,) float32`` in [-1, 1] at
+    ``sample_rate`` Hz (synthesized speech; recorded speech stays a file)."""
+
+    samples: np.ndarray
+    sample_rate: int
 
 
 @dataclass(frozen=True, eq=False)
@@ -42,12 +59,17 @@ class VisemeAnimation:
     speaking: ``(n_frames,) bool``, read-only: True where a sound other than silence is
         shown (the gaze model's "talking" state).
     speech: the full timeline (phones, words, visemes) in storyboard time.
+    audio: the synthesized speech (text without a recording), or None.
+    loudness: ``(n_frames,) float32`` dBFS, read-only: the RMS level of the phone under each
+        frame (:data:`facelib.speech.loudness.FLOOR_DB` where there is no audio).
     """
 
     track: FapTrack
     timeline: tuple[VisemeSpan, ...]
     speaking: np.ndarray
     speech: SpeechTimeline
+    audio: SpeechAudio | None = None
+    loudness: np.ndarray | None = None
 
 
 def align(audio: str | Path | np.ndarray, text: str | None = None, *,
@@ -58,23 +80,47 @@ def align(audio: str | Path | np.ndarray, text: str | None = None, *,
                                      on_implausible=on_implausible))
 
 
+def align_dtw(audio: str | Path | np.ndarray, text: str, *, lang: str = DEFAULT_LANGUAGE,
+              voice: str | None = None, sample_rate: int | None = None) -> SpeechTimeline:
+    """:func:`facelib.speech.dtw.align_dtw` (any language) with the visemes of its phones."""
+    return with_visemes(align_phones_dtw(audio, text, lang=lang, voice=voice,
+                                         sample_rate=sample_rate))
+
+
+def synthesize(text: str, *, lang: str = DEFAULT_LANGUAGE, voice: str | None = None,
+               rate: float = 1.0, pitch: float = 50) -> tuple[SpeechTimeline, SpeechAudio]:
+    """:func:`facelib.speech.synthesize` (same arguments): the timeline with visemes, and
+    the audio."""
+    made = synthesize_speech(text, lang=lang, voice=voice, rate=rate, pitch=pitch)
+    return with_visemes(made.timeline), SpeechAudio(made.samples, made.sample_rate)
+
+
 def timeline_from_text(text: str, *, rate: float = 1.0) -> SpeechTimeline:
     """:func:`facelib.speech.timeline_from_text` with the visemes of its phones."""
     return with_visemes(phones_from_text(text, rate=rate))
 
 
-def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0) -> SpeechTimeline:
+def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0,
+                    language: str | None = None) -> SpeechTimeline:
     """The timeline of ``speech`` in its own time (ms from ``speech.start_ms``): a stored
-    viseme script as it is; audio and text by forced alignment; audio alone by phone-loop
-    recognition; text alone by the duration model at speaking ``rate``."""
+    viseme script as it is; audio and text by forced alignment (English: pocketsphinx,
+    falling back to DTW; other languages: DTW against espeak-ng); audio alone by
+    phone-loop recognition (English); text alone synthesized by espeak-ng. ``rate``
+    multiplies ``speech.rate``; ``language`` is the storyboard's (``speech.lang`` wins)."""
+    return _spoken(speech, rate=rate, language=language)[0]
+
+
+def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
+            ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+    lang = speech.lang or language or DEFAULT_LANGUAGE
     if speech.visemes:
         spans = visemes_from_cues(speech.visemes)
         shifted = tuple(s.shifted(-speech.start_ms) for s in spans)
         end = max(s.end_ms for s in shifted)
-        return SpeechTimeline((), (), shifted, "script", end)
+        return SpeechTimeline((), (), shifted, "script", end), None
     if speech.audio is not None:
         try:
-            return align(speech.audio, speech.text)
+            return with_visemes(_recorded(speech.audio, speech.text, lang, speech.voice)), None
         except SpeechError as exc:
             if speech.origin is None or (exc.path is not None and exc.line is not None):
                 raise
@@ -85,24 +131,51 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0) -> SpeechTimeline:
             path, line = speech.origin if speech.origin else (None, None)
             raise SpeechError(f"speech text has {len(speech.text)} characters, more than "
                               f"{MAX_SPEECH_TEXT_CHARS}", path=path, line=line)
-        return timeline_from_text(speech.text, rate=rate)
+        try:
+            made = synthesize_speech(speech.text, lang=lang, voice=speech.voice,
+                              rate=min(max(speech.rate * rate, 0.5), 2.5), pitch=speech.pitch)
+        except MissingExtraError:
+            if not lang.lower().startswith("en"):
+                raise
+            warnings.warn("no speech synthesis (install facelib[speech]): the English duration "
+                          "model times the text and the video is silent", SpeechWarning,
+                          stacklevel=3)
+            return timeline_from_text(speech.text, rate=speech.rate * rate), None
+        return with_visemes(made.timeline), SpeechAudio(made.samples, made.sample_rate)
     path, line = speech.origin if speech.origin else (None, None)
     raise SpeechError("speech has neither audio, text nor a viseme script", path=path, line=line)
 
 
+def _recorded(audio: Path, text: str | None, lang: str, voice: str | None) -> PhoneTimeline:
+    """Phones of recorded ``audio``: pocketsphinx for English (DTW if it fails), DTW
+    against the synthesized transcript for any other language."""
+    if lang.lower().startswith("en"):
+        try:
+            return align_phones(audio, text)
+        except SpeechError:
+            if text is None:
+                raise
+            return align_phones_dtw(audio, text, lang=lang, voice=voice)
+    if text is None:
+        raise SpeechError(f"speech audio in {lang!r} needs its transcript (recognition without "
+                          "one is English only)", path=audio)
+    return align_phones_dtw(audio, text, lang=lang, voice=voice)
+
+
 def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
-            max_frames: int = MAX_FRAMES) -> VisemeAnimation:
+            language: str | None = None, max_frames: int = MAX_FRAMES) -> VisemeAnimation:
     """Mouth, jaw and tongue FAP curves for ``speech``.
 
     Frame i of the track is at ``i / fps`` s of the storyboard; the track ends at the last
     frame inside the speech. Values come from the coarticulation blend of the viseme
     targets; weights are the speech envelope on the driven FAPs (0 elsewhere).
-    ``rate`` is the speaking rate of the text-only duration model. Speech longer than
-    ``max_frames`` raises SpeechError before the curves are computed.
+    ``rate`` multiplies the speech's own speaking rate; ``language`` is the storyboard's.
+    Speech longer than ``max_frames`` raises SpeechError before the curves are computed.
     """
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
-    timeline = speech_timeline(speech, rate=rate).shifted(speech.start_ms)
+    own, audio = _spoken(speech, rate=rate, language=language)
+    timeline = own.shifted(speech.start_ms)
     end_ms = speech.start_ms + timeline.duration_ms
     n_frames = math.floor(end_ms * fps / 1000) + 1
     if n_frames > max_frames:
@@ -115,4 +188,27 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     weight[:, driven_faps()] = envelope(timeline.visemes, times)[:, None]
     speaking = speaking_mask(timeline.visemes, times)
     speaking.flags.writeable = False
-    return VisemeAnimation(FapTrack(fps, values, weight), timeline.visemes, speaking, timeline)
+    loudness = _frame_loudness(speech, own, audio, times - speech.start_ms)
+    return VisemeAnimation(FapTrack(fps, values, weight), timeline.visemes, speaking, timeline,
+                           audio, loudness)
+
+
+def _frame_loudness(speech: SpeechSpec, timeline: SpeechTimeline, audio: SpeechAudio | None,
+                    times_ms: np.ndarray) -> np.ndarray:
+    """``(n_frames,) float32`` dBFS of the phone under each frame (times in the speech's own
+    ms); the floor where there is no audio or no phone."""
+    out = np.full(times_ms.size, FLOOR_DB, np.float32)
+    phones = timeline.phones
+    if phones and (audio is not None or speech.audio is not None):
+        if audio is not None:
+            samples, sample_rate = audio.samples, audio.sample_rate
+        else:
+            samples, sample_rate = load_speech(speech.audio), ALIGN_RATE  # type: ignore[arg-type]
+        levels = phone_loudness(samples, sample_rate=sample_rate, spans=phones)
+        starts = np.array([p.start_ms for p in phones], np.float64)
+        ends = np.array([p.end_ms for p in phones], np.float64)
+        k = np.clip(np.searchsorted(starts, times_ms, side="right") - 1, 0, len(phones) - 1)
+        inside = (times_ms >= starts[k]) & (times_ms < ends[k])
+        out[inside] = levels[k[inside]]
+    out.flags.writeable = False
+    return out

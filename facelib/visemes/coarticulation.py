@@ -21,7 +21,7 @@ from facelib.visemes.tables import (
 )
 from facelib.visemes.timeline import VisemeSpan
 
-__all__ = ["blend", "driven_faps", "envelope", "frame_times_ms", "speaking_mask"]
+__all__ = ["blend", "driven_faps", "envelope", "frame_times_ms", "speaking_mask", "window_ms"]
 
 _BILABIAL = 1
 _LOWER_LIP = ("raise_b_midlip", "raise_b_lip_lm", "raise_b_lip_rm", "raise_b_midlip_o",
@@ -41,6 +41,22 @@ def driven_faps() -> np.ndarray:
     return mask
 
 
+_CHUNK_FRAMES = 512
+_NEGLIGIBLE = 1e-7
+"""Relative dominance below which a span no longer shapes a frame (sets the window)."""
+
+
+def window_ms() -> float:
+    """How far (ms) a span's influence reaches: beyond it, the dominance of any span is below
+    :data:`_NEGLIGIBLE` times that of the span under the frame, whatever their magnitudes
+    (``ln(alpha_max / alpha_min / 1e-7) / theta_min``; about 2.5 s with the shipped table).
+    Coarticulation is local, so each frame needs only the spans within this window."""
+    table = dominance_table().values()
+    ratio = max(d.alpha for d in table) / min(d.alpha for d in table)
+    theta = min(min(d.theta_before, d.theta_after) for d in table)
+    return 1000.0 * float(np.log(ratio / _NEGLIGIBLE)) / theta
+
+
 def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
     """FAP values ``(len(times_ms), 84) float32`` (FAP units) of the viseme sequence.
 
@@ -49,6 +65,9 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
     (0 inside it; ``theta_before`` before it, ``theta_after`` after it). Each FAP is the
     dominance-weighted mean of the spans' targets. The lips then close on every p/b/m
     (see ``_close_bilabials``). FAPs outside the classes stay 0.
+
+    Frames are taken in chunks, each with the spans within :func:`window_ms` of it only, so
+    memory and time grow linearly with the length of the speech (``times_ms`` ascending).
     """
     times = np.asarray(times_ms, dtype=np.float64)
     out = np.zeros((times.size, N_FAPS), np.float32)
@@ -57,6 +76,23 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
     ids = np.array([s.viseme for s in visemes])
     start = np.array([s.start_ms for s in visemes], np.float64)
     end = np.array([s.end_ms for s in visemes], np.float64)
+    reach = window_ms()
+    n_spans = len(visemes)
+    for lo in range(0, times.size, _CHUNK_FRAMES):
+        t = times[lo:lo + _CHUNK_FRAMES]
+        first = min(int(np.searchsorted(end, t.min() - reach, side="left")), n_spans - 1)
+        last = max(int(np.searchsorted(start, t.max() + reach, side="right")), first + 1)
+        part = slice(first, last)
+        out[lo:lo + t.size] = _blend_dense(ids[part], start[part], end[part], t)
+    _close_bilabials(out, visemes, times, reach)
+    return out
+
+
+def _blend_dense(ids: np.ndarray, start: np.ndarray, end: np.ndarray,
+                 times: np.ndarray) -> np.ndarray:
+    """The dominance blend of spans ``ids`` ``[start, end)`` at ``times``: ``(len(times),
+    84) float32``, with a ``(len(times), len(ids))`` dominance matrix per FAP class."""
+    out = np.zeros((times.size, N_FAPS), np.float32)
     before = np.maximum(start[None, :] - times[:, None], 0.0) / 1000.0  # (n_frames, n_spans)
     after = np.maximum(times[:, None] - end[None, :], 0.0) / 1000.0
     targets = viseme_targets()[ids]  # (n_spans, 84)
@@ -72,16 +108,17 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
         dom = np.exp(log_dom)
         cols = list(columns)
         out[:, cols] = (dom @ targets[:, cols]) / dom.sum(axis=1, keepdims=True)
-    _close_bilabials(out, visemes, times)
     return out
 
 
-def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.ndarray) -> None:
+def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.ndarray,
+                     reach: float) -> None:
     """Make the lips meet on every p/b/m, whatever the jaw does (speakers close the lips
     with the jaw part open): inside the span the lip heights are the closure's, and the
     lower lip rises by the jaw's extra opening (the jaw carries the lower lip; both in MNS).
     The correction fades outside the span with the bilabial's own dominance fall-off, so
-    the lips close smoothly; the frame nearest a span shorter than a frame is closed too."""
+    the lips close smoothly; the frame nearest a span shorter than a frame is closed too.
+    Only frames within ``reach`` ms of the span are touched (beyond, the fade is nil)."""
     classes = coarticulation_classes()
     lip = list(classes["lip_height"])
     targets = viseme_targets()
@@ -91,15 +128,21 @@ def _close_bilabials(out: np.ndarray, visemes: Sequence[VisemeSpan], times: np.n
     for span in visemes:
         if span.viseme != _BILABIAL:
             continue
-        before = np.maximum(span.start_ms - times, 0.0) / 1000.0
-        after = np.maximum(times - span.end_ms, 0.0) / 1000.0
+        lo = int(np.searchsorted(times, span.start_ms - reach, side="left"))
+        hi = int(np.searchsorted(times, span.end_ms + reach, side="right"))
+        t = times[lo:hi]
+        if t.size == 0:
+            continue
+        before = np.maximum(span.start_ms - t, 0.0) / 1000.0
+        after = np.maximum(t - span.end_ms, 0.0) / 1000.0
         c = np.exp(-dom.theta_before * before - dom.theta_after * after)
-        if not np.any((times >= span.start_ms) & (times < span.end_ms)):
+        if not np.any((t >= span.start_ms) & (t < span.end_ms)):
             centre = 0.5 * (span.start_ms + span.end_ms)
-            c[int(np.argmin(np.abs(times - centre)))] = 1.0
-        out[:, lip] += c[:, None] * (targets[_BILABIAL, lip][None, :] - out[:, lip])
-        extra = np.maximum(out[:, jaw] - targets[_BILABIAL, jaw], 0.0)
-        out[:, lower] += (c * extra)[:, None]
+            c[int(np.argmin(np.abs(t - centre)))] = 1.0
+        block = out[lo:hi]
+        block[:, lip] += c[:, None] * (targets[_BILABIAL, lip][None, :] - block[:, lip])
+        extra = np.maximum(block[:, jaw] - targets[_BILABIAL, jaw], 0.0)
+        block[:, lower] += (c * extra)[:, None]
 
 
 def speaking_mask(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.ndarray:
@@ -108,7 +151,9 @@ def speaking_mask(visemes: Sequence[VisemeSpan], times_ms: np.ndarray) -> np.nda
     mask = np.zeros(times.size, bool)
     for span in visemes:
         if not span.is_silence:
-            mask |= (times >= span.start_ms) & (times < span.end_ms)
+            lo = int(np.searchsorted(times, span.start_ms, side="left"))
+            hi = int(np.searchsorted(times, span.end_ms, side="left"))
+            mask[lo:hi] = True
     return mask
 
 
@@ -141,10 +186,13 @@ def envelope(
     times = np.asarray(times_ms, dtype=np.float64)
     env = np.zeros(times.size, np.float64)
     for lo, hi in active:
-        dist = np.maximum(np.maximum(lo - times, times - hi), 0.0)
+        first = int(np.searchsorted(times, lo - ramp, side="left"))
+        last = int(np.searchsorted(times, hi + ramp, side="right"))
+        t = times[first:last]
+        dist = np.maximum(np.maximum(lo - t, t - hi), 0.0)
         if ramp > 0:
             part = np.where(dist < ramp, 0.5 * (1.0 + np.cos(np.pi * dist / ramp)), 0.0)
         else:
             part = (dist == 0).astype(np.float64)
-        env = np.maximum(env, part)
+        env[first:last] = np.maximum(env[first:last], part)
     return env.astype(np.float32)

@@ -8,8 +8,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
+from facelib.errors import ParameterError
+from facelib.visemes.ipa import ipa_viseme
 from facelib.visemes.tables import phone_viseme, timing_rules, viseme_name
-from facelib.visemes.timeline import PhoneTimeline, Span, SpeechTimeline, VisemeSpan
+from facelib.visemes.timeline import Alphabet, PhoneTimeline, Span, SpeechTimeline, VisemeSpan
 
 __all__ = ["enforce_min_duration", "merge_short_silences", "phones_to_visemes", "visemes_for",
            "with_visemes"]
@@ -17,18 +19,26 @@ __all__ = ["enforce_min_duration", "merge_short_silences", "phones_to_visemes", 
 _BILABIAL = 1
 
 
-def phones_to_visemes(phones: Sequence[Span]) -> tuple[VisemeSpan, ...]:
-    """One viseme span per phone (two for a diphthong, split as the table says); adjacent
-    spans of the same viseme are joined and keep all their phones."""
+def phones_to_visemes(
+    phones: Sequence[Span], *, alphabet: Alphabet = "arpabet"
+) -> tuple[VisemeSpan, ...]:
+    """One viseme span per phone (two for a diphthong, split as the table says; an IPA
+    phone of n symbols with distinct visemes: n equal parts); adjacent spans of the same
+    viseme are joined and keep all their phones. ``alphabet`` says how the phone labels
+    are written: ARPAbet (``phone_to_viseme.csv``) or IPA (``ipa_to_viseme.csv``)."""
+    if alphabet not in ("arpabet", "ipa"):
+        raise ParameterError(f"alphabet must be 'arpabet' or 'ipa', not {alphabet!r}")
+    rule_of = ipa_viseme if alphabet == "ipa" else phone_viseme
     spans: list[VisemeSpan] = []
     for phone in phones:
-        rule = phone_viseme(phone.label)
+        rule = rule_of(phone.label)
         label = rule.phone
-        if len(rule.visemes) == 1:
-            cuts = [phone.start_ms, phone.end_ms]
-        else:
+        n = len(rule.visemes)
+        if n == 2:
             mid = phone.start_ms + round(rule.split * phone.duration_ms)
             cuts = [phone.start_ms, mid, phone.end_ms]
+        else:
+            cuts = [phone.start_ms + round(k * phone.duration_ms / n) for k in range(n + 1)]
         for vid, start, end in zip(rule.visemes, cuts[:-1], cuts[1:], strict=True):
             if end <= start:
                 continue
@@ -70,18 +80,20 @@ def enforce_min_duration(
     bilabial (p b m), whose closure must show: its neighbour gives way instead."""
     min_len = timing_rules()["min_visible_ms"] if min_ms is None else min_ms
     out = list(visemes)
-    changed = True
-    while changed:
-        changed = False
-        for i, span in enumerate(out):
-            need = min_len - span.duration_ms
-            if need <= 0 or len(out) == 1:
-                continue
-            need = _borrow(out, i, need, min_len)
-            if need > 0:
-                _merge(out, i)
-            changed = True
-            break
+    # Fix the first span that is too short, then look again from just before it: a fix
+    # only touches that span and its neighbours, and never makes an earlier span too short
+    # (neighbours lend only what they can spare), so spans further back stay fixed. Linear
+    # in the number of spans, where restarting from the first span was quadratic.
+    i = 0
+    while i < len(out):
+        need = min_len - out[i].duration_ms
+        if need <= 0 or len(out) == 1:
+            i += 1
+            continue
+        need = _borrow(out, i, need, min_len)
+        if need > 0:
+            _merge(out, i)
+        i = max(i - 2, 0)
     return tuple(out)
 
 
@@ -115,12 +127,17 @@ def _merge(out: list[VisemeSpan], i: int) -> None:
     del out[drop]
 
 
-def visemes_for(phones: Sequence[Span]) -> tuple[VisemeSpan, ...]:
+def visemes_for(
+    phones: Sequence[Span], *, alphabet: Alphabet = "arpabet"
+) -> tuple[VisemeSpan, ...]:
     """The whole chain: map, merge short silences, enforce minimum durations."""
-    return enforce_min_duration(merge_short_silences(phones_to_visemes(phones)))
+    return enforce_min_duration(
+        merge_short_silences(phones_to_visemes(phones, alphabet=alphabet))
+    )
 
 
 def with_visemes(timeline: PhoneTimeline) -> SpeechTimeline:
     """``timeline`` (phones and words of :mod:`facelib.speech`) with its viseme spans."""
-    return SpeechTimeline(timeline.phones, timeline.words, visemes_for(timeline.phones),
-                          timeline.source, timeline.duration_ms)
+    return SpeechTimeline(timeline.phones, timeline.words,
+                          visemes_for(timeline.phones, alphabet=timeline.alphabet),
+                          timeline.source, timeline.duration_ms, alphabet=timeline.alphabet)

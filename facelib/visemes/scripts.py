@@ -45,6 +45,7 @@ def timeline_to_json(timeline: SpeechTimeline) -> dict[str, Any]:
     """The timeline as a JSON-ready dict (times in seconds)."""
     return {
         "source": timeline.source,
+        "alphabet": timeline.alphabet,
         "duration": _s(timeline.duration_ms),
         "phones": [{"phone": p.label, "start": _s(p.start_ms), "end": _s(p.end_ms)}
                    for p in timeline.phones],
@@ -69,11 +70,14 @@ def timeline_from_json(data: Mapping[str, Any]) -> SpeechTimeline:
             for v in data["visemes"]
         )
         source = data.get("source", "script")
+        alphabet = data.get("alphabet", "arpabet")
+        if alphabet not in ("arpabet", "ipa"):
+            raise ValueError(f"alphabet {alphabet!r}")
         duration = ms(data["duration"]) if "duration" in data else max(
             (v.end_ms for v in visemes), default=0)
     except (KeyError, TypeError, ValueError) as exc:
         raise ParameterError(f"not a speech timeline: {exc!r}") from exc
-    return SpeechTimeline(phones, words, visemes, source, duration)
+    return SpeechTimeline(phones, words, visemes, source, duration, alphabet)
 
 
 def timeline_to_tsv(timeline: SpeechTimeline) -> str:

@@ -6,9 +6,17 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from facelib.errors import ParameterError
-from facelib.speech.timeline import SILENCE, PhoneTimeline, Source, Span, check_interval
+from facelib.speech.timeline import (
+    SILENCE,
+    Alphabet,
+    PhoneTimeline,
+    Source,
+    Span,
+    check_interval,
+)
 
-__all__ = ["SILENCE", "PhoneTimeline", "Source", "Span", "SpeechTimeline", "VisemeSpan"]
+__all__ = ["SILENCE", "Alphabet", "PhoneTimeline", "Source", "Span", "SpeechTimeline",
+           "VisemeSpan"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,6 +60,7 @@ class SpeechTimeline:
         ``"phone-loop"`` recognition of audio alone, ``"durations"`` (text only, duration
         model) or ``"script"`` (a stored viseme script).
     duration_ms: length of the speech (the audio's length where there is audio).
+    alphabet: how phone labels are written, ``"arpabet"`` or ``"ipa"``.
     """
 
     phones: tuple[Span, ...]
@@ -59,6 +68,7 @@ class SpeechTimeline:
     visemes: tuple[VisemeSpan, ...]
     source: Source
     duration_ms: int
+    alphabet: Alphabet = "arpabet"
 
     def shifted(self, offset_ms: int) -> SpeechTimeline:
         """The same timeline ``offset_ms`` later."""
@@ -68,4 +78,5 @@ class SpeechTimeline:
             tuple(s.shifted(offset_ms) for s in self.visemes),
             self.source,
             self.duration_ms,
+            self.alphabet,
         )

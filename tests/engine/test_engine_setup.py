@@ -141,7 +141,7 @@ def test_cli_face_setup_then_render(tmp_path: Path, capsys) -> None:  # type: ig
     out = tmp_path / "cartoon"
     assert main(["face", "setup", str(HEADS / "cartoon_head.obj"), "--landmarks",
                  str(HEADS / "cartoon_landmarks.json"), "-o", str(out)]) == 0
-    text = capsys.readouterr().err  # status goes to stderr
+    text = capsys.readouterr().err  # status lines go to stderr
     assert "eye_l, eye_r, teeth_upper, teeth_lower, tongue warped into place" in text
     face = load_face(out / "face.json")
     assert face.n_vertices > load_head_mesh(HEADS / "cartoon_head.obj").vertices.shape[0]

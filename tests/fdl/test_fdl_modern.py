@@ -115,3 +115,27 @@ def test_marking_keeps_lines_and_strings():
     assert "f(__fdl_at(4,{ x = __fdl_at(4,{}) }))" in marked
     sb = fdl.loads(src.replace("f{", "t = {").replace('s"{"{1}', "2"))
     assert sb.fps == 25.0
+
+
+def test_say_language_voice_rate_and_pitch():
+    sb = fdl.loads('language = "pt"\nsay { "Olá, tudo bem?", voice = "pt-br", rate = 1.2, '
+                   'pitch = 60 }')
+    assert sb.language == "pt"
+    s = sb.speech
+    assert (s.text, s.lang, s.voice, s.rate, s.pitch) == ("Olá, tudo bem?", None, "pt-br", 1.2,
+                                                          60.0)
+    sb = fdl.loads('say { "Hola", lang = "es" }')
+    assert sb.language is None and sb.speech.lang == "es"
+    assert (sb.speech.rate, sb.speech.pitch) == (1.0, 50.0)
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('say { "Hi", rate = 9 }', "rate must be a number from 0.5 to 2.5"),
+    ('say { "Hi", pitch = "high" }', "pitch must be a number from 0 to 100"),
+    ('say { "Hi", lang = 3 }', "lang must be a string"),
+    ('say { "Hi", speed = 2 }', "unknown field 'speed'"),
+    ('language = 5\nsay "Hi"', "language must be a language code"),
+])
+def test_say_speech_options_are_checked(text, message):
+    with pytest.raises(FdlError, match=message):
+        fdl.loads(text)

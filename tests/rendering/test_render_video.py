@@ -145,3 +145,19 @@ def test_outputs_get_ordinary_permissions(tmp_path, synthetic_face, jaw_stream):
     assert stat.S_IMODE(png.stat().st_mode) == 0o644
     assert stat.S_IMODE(gif.stat().st_mode) == 0o644
     assert stat.S_IMODE(folder.stat().st_mode) == 0o755
+
+
+@pytest.mark.speech
+def test_text_only_storyboard_renders_with_synthesized_speech(tmp_path, synthetic_face):
+    from facelib import run_fdl
+
+    story = tmp_path / "de.fdl"
+    story.write_text('language = "de"\nsay "Mama backt Brot."\n', encoding="utf-8")
+    anim = run_fdl(story)
+    out = render(anim, face=synthetic_face, out=tmp_path / "de.mp4", width=W, height=H,
+                 progress=False)
+    info = probe_video(out)
+    assert info["audio"]
+    assert info["frames"] == anim.faps.n_frames
+    speech = anim.speech_audio
+    assert abs(info["duration"] - speech.samples.size / speech.sample_rate) < 0.1

@@ -23,7 +23,7 @@ def test_text_only_track_shape_weights_and_offset():
     assert not track.weight[:, ~driven_faps()].any()
     assert not track.weight[: int(0.8 * 25)].any()  # nothing before the speech starts
     assert track.weight[:, fap("open_jaw").index].max() == 1
-    assert anim.timeline[0].start_ms == 1000 and anim.speech.source == "durations"
+    assert anim.timeline[0].start_ms == 1000 and anim.speech.source == "synthesis"
     assert anim.speaking.any() and not anim.speaking[:25].any()
     assert not anim.speaking.flags.writeable
     # the first bilabial is closed at its frames
