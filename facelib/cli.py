@@ -379,7 +379,8 @@ def _add_view(commands: Any) -> None:
         "view", parents=[_COMMON],
         help="play a .fap or storyboard in a window (space: pause, arrows: step, q: quit)")
     view.add_argument("source", help="STORY.fdl or FILE.fap")
-    view.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    view.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
+                      "folder (default: the storyboard's face, else the bundled head)")
     view.add_argument("--loop", action="store_true", help="replay until the window is closed")
     view.add_argument("--mute", action="store_true", help="do not play the speech audio")
     view.add_argument("--seed", type=int)

@@ -193,13 +193,12 @@ def _candidates(surf: Surface, pts: np.ndarray, radius: np.ndarray) -> tuple[np.
     rows = np.repeat(np.repeat(np.arange(len(hits)), per_row), counts)
     offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
     tris = surf.triangle_of[offsets + np.arange(int(counts.sum()))]
-    n_tri = len(surf.triangles)
-    pairs = np.unique(rows * n_tri + tris)  # a triangle is found through each corner
-    rows, tris = pairs // n_tri, pairs % n_tri
     # no point of a triangle is nearer than its centroid's distance minus its size
     gap = np.linalg.norm(pts[rows] - surf.centroids[tris], axis=1) - surf.sizes[tris]
     keep = gap <= radius[rows] - surf.radius
-    return rows[keep], tris[keep]
+    n_tri = len(surf.triangles)
+    pairs = np.unique(rows[keep] * n_tri + tris[keep])  # found through each corner
+    return pairs // n_tri, pairs % n_tri
 
 
 def closest_on_triangles(corners: np.ndarray, points: np.ndarray) -> np.ndarray:

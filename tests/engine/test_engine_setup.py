@@ -158,6 +158,11 @@ def test_cli_face_setup_then_render(tmp_path: Path, capsys) -> None:  # type: ig
         assert main(["render", str(story), "-o", str(gif), "--width", "96", "--height",
                      "72", "--fps", "5"]) == 0
         assert gif.stat().st_size > 1000
+        frames = tmp_path / "frames"
+        assert main(["play", str(ROOT / "examples" / "fap" / "xface_smile.fap"), "--face",
+                     str(out), "-o", str(frames), "--width", "96", "--height", "72",
+                     "--fps", "2"]) == 0
+        assert len(list(frames.glob("*.png"))) >= 2
 
 
 def test_cli_bad_input_writes_nothing(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
