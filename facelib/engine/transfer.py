@@ -5,7 +5,9 @@
    (eq. 4.7, with a normal check): the *guide model*;
 3. each target vertex takes the source attributes interpolated (barycentric) at its closest
    point on the guide: region membership (an indicator, kept at >= 0.5), per-vertex weights
-   (jaw, eyelids) and colours;
+   (jaw, eyelids), learned displacements and colours. Weights and displacements are
+   interpolated as 0 at non-members (the source does not move them), so a vertex on a
+   region's border gets the source's own, smaller motion there, not its members' average;
 4. point attributes (feature points, RBF anchors) go to the target vertex nearest to their
    guide position; pivots and the neck plane go through ``T`` (normals by ``J^-T``, lengths
    by ``|det J|^(1/3)``);
@@ -251,15 +253,16 @@ class _Mapper:
                 field = np.zeros(block.guide.shape[0])
                 field[self.local_of[sub]] = region.weights[np.isin(region.vertices, sub)]
                 value = block.match.interpolate(block.guide_surface, field)[keep]
-                weights.append(np.clip(value / np.maximum(inside[keep], 0.5), 0.0, 1.0))
+                weights.append(np.clip(value, 0.0, 1.0))
             if region.displacements.size:  # a learned field: each axis like a weight
+                # (0 at non-members, like the weights: not renormalised by `inside`)
                 axes = []
                 for axis in range(3):
                     field = np.zeros(block.guide.shape[0])
                     field[self.local_of[sub]] = region.displacements[
                         np.isin(region.vertices, sub), axis]
                     value = block.match.interpolate(block.guide_surface, field)[keep]
-                    axes.append(value / np.maximum(inside[keep], 0.5))
+                    axes.append(value)
                 moves.append(np.stack(axes, axis=1))
         ids = np.concatenate(members)
         order = np.argsort(ids, kind="stable")

@@ -160,9 +160,9 @@ def test_x3_subdivided_skin(source) -> None:  # type: ignore[no-untyped-def]
         assert np.abs(moved[:n_skin] - before[:n_skin]).max() <= 1e-6, name
         mids = moved[n_skin : n_skin + len(edges)]
         gap = np.linalg.norm(mids - before[edges].mean(axis=1), axis=1)
-        # eyelids rotate by weight x angle after the linear step: not linear along an
-        # edge, and in "all" they turn what smile and brows moved (measured p99 1.26 mm)
-        assert np.percentile(gap, 99) <= (1.5e-3 if name == "all" else 1e-3), name
+        # the reference's 1 mm in every frame, "all" included (measured p99 0.86 mm: the
+        # brows' RBF and the lids' rotation are not linear along an edge)
+        assert np.percentile(gap, 99) <= 1e-3, name
 
 
 def _noisy(source, sigma: float, seed: int):  # type: ignore[no-untyped-def]
