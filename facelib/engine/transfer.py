@@ -26,10 +26,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from facelib.engine import rigid
+from facelib.engine.eyelids import close_upper_lid
 from facelib.engine.face import PART_NAMES, Face, Region
+from facelib.engine.fapu import compute_fapu
 from facelib.engine.headmesh import HeadMesh
 from facelib.engine.surface import Surface, SurfacePoints, closest_points, surface, vertex_normals
 from facelib.engine.tps import ThinPlateSpline
+from facelib.mpeg4.tables import fap_table
 
 __all__ = ["transfer_face"]
 
@@ -111,12 +115,17 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         local_of[ids] = np.arange(ids.size)
     mapper = _Mapper(blocks, part_of, local_of)
     points = mapper.feature_points(source.feature_points, landmark_vertices)
-    regions = tuple(mapper.region(r, points) for r in source.regions)
+    pivots = _pivots(source, tps, blocks, positions)
+    verts = np.concatenate(positions)
+    parts = _part_ranges(positions)
+    regions = _closed_lids(tuple(mapper.region(r, points) for r in source.regions),
+                           verts=verts, skin=triangles[0], points=points, pivots=pivots,
+                           eyes={p: parts[p] for p in ("eye_l", "eye_r")})
     return Face.build(
-        vertices=np.concatenate(positions), triangles=np.concatenate(triangles),
+        vertices=verts, triangles=np.concatenate(triangles),
         vertex_colors=np.clip(np.concatenate(colours), 0, 1),
-        parts=_part_ranges(positions), feature_points=points, regions=regions,
-        pivots=_pivots(source, tps, blocks, positions), neck=_neck(source, tps))
+        parts=parts, feature_points=points, regions=regions,
+        pivots=pivots, neck=_neck(source, tps))
 
 
 def _dense(warped: np.ndarray, src_tris: np.ndarray, pos: np.ndarray, tris: np.ndarray, *,
@@ -166,6 +175,30 @@ def _sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
     sol = np.linalg.lstsq(a, b, rcond=None)[0]
     centre = sol[:3]
     return centre, float(np.sqrt(max(sol[3] + centre @ centre, 0.0)))
+
+
+def _closed_lids(regions: tuple[Region, ...], *, verts: np.ndarray, skin: np.ndarray,
+                 points: Mapping[str, int], pivots: Mapping[str, np.ndarray],
+                 eyes: Mapping[str, np.ndarray]) -> tuple[Region, ...]:
+    """The upper eyelid regions refitted to close over the target's eye opening
+    (:func:`facelib.engine.eyelids.close_upper_lid`). verts: (V, 3) output positions;
+    skin: (F, 3) skin triangles; eyes: eye part name -> its vertex ids."""
+    fapu = compute_fapu(verts, points)
+    out = []
+    for region in regions:
+        fp_id = region.feature_points[0] if region.feature_points else ""
+        info = next((f for f in fap_table() if f.fapu == "IRISD" and f.direction[1] < 0
+                     and f.feature_points == (fp_id,)), None)
+        if region.deformer != "eyelid" or info is None or region.pivot not in eyes:
+            out.append(region)
+            continue
+        centre = pivots[region.pivot]
+        full = rigid.hinge_angle(verts[points[fp_id]], centre,
+                                 np.array([1024 * fapu[info.fapu] * info.direction[1]]))[0]
+        radius = float(np.linalg.norm(verts[eyes[region.pivot]] - centre, axis=1).max())
+        out.append(close_upper_lid(region, vertices=verts, triangles=skin, centre=centre,
+                                   radius=radius, full_angle=float(full)))
+    return tuple(out)
 
 
 def _neck(source: Face, tps: ThinPlateSpline) -> tuple[np.ndarray, np.ndarray, float]:

@@ -135,3 +135,26 @@ def test_named_framings_and_the_default_face_close_up():
     assert spans["face"] > spans["head"] > spans["bust"] > 0.15
     with pytest.raises(ParameterError, match="framing must be one of"):
         FaceRenderer(face, width=64, height=64, framing="shoulders")
+
+
+def test_closed_lids_cover_the_cartoons_bigger_eyes(fap_frame):
+    """Issue 15: on the cartoon head (eyes much taller than the default head's) the
+    transferred upper lids close over the whole eye too."""
+    from pathlib import Path
+
+    from facelib.engine.setup import read_landmarks, setup_face
+
+    heads = Path(__file__).resolve().parents[2] / "examples" / "heads"
+    face = setup_face(heads / "cartoon_head.obj",
+                      landmarks=read_landmarks(heads / "cartoon_landmarks.json"))
+    fp = face.feature_points
+    lids = face.vertices[[fp[k] for k in ("3.1", "3.2", "3.3", "3.4")]]
+    side = np.array([0.014, 0.0, 0.0])
+    with FaceRenderer(face, width=400, height=150, framing=np.vstack([lids + side,
+                                                                      lids - side])) as renderer:
+        white = []
+        for values in (fap_frame(), fap_frame(f19=1024, f20=1024)):
+            image = renderer.frame(face.deform_frame(values)).astype(int)
+            white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
+    assert white[0] > 1000
+    assert white[1] < 0.01 * white[0]
