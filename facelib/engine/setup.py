@@ -20,7 +20,7 @@ import numpy as np
 from facelib.engine.definition import default_face
 from facelib.engine.face import PART_NAMES, Face
 from facelib.engine.headmesh import HeadMesh, axes_rotation, load_head_mesh
-from facelib.engine.surface import closest_points, surface
+from facelib.engine.surface import Surface, closest_points, surface
 from facelib.engine.tps import ThinPlateSpline, check_landmarks, fit_tps
 from facelib.engine.transfer import transfer_face
 from facelib.errors import FaceModelError, ParameterError
@@ -156,19 +156,18 @@ def set_up_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | s
         points = (points * factor) @ rotation.T
         head = HeadMesh((head.vertices * factor) @ rotation.T, head.triangles, head.parts,
                         head.colors, head.name)
-    residual = _residuals(head, ids, points, src)
+    skin = surface(head.vertices[head.parts["skin"]], head.part_triangles("skin"))
+    residual = _residuals(skin, ids, points, src)
     tps = fit_tps(source_points, points)
     carried = tuple(p for p in PART_NAMES if p not in head.parts)
-    face = transfer_face(src, head, tps, vertices, min_cos=min_normal_cos)
+    face = transfer_face(src, head, tps, vertices, min_cos=min_normal_cos, skin=skin)
     return FaceSetup(face=face, unit=unit, rotation=rotation @ given, carried=carried,
                      landmarks=tuple(ids), residual=residual, tps=tps)
 
 
-def _residuals(head: HeadMesh, ids: Sequence[str], points: np.ndarray, src: Face) -> np.ndarray:
-    """Distance of each landmark to the mesh; an error for one clearly off the surface."""
-    on_skin = np.array([src.feature_points[i] in set(src.parts["skin"].vertex_ids.tolist())
-                        for i in ids])
-    skin = surface(head.vertices[head.parts["skin"]], head.part_triangles("skin"))
+def _residuals(skin: Surface, ids: Sequence[str], points: np.ndarray, src: Face) -> np.ndarray:
+    """Distance of each landmark to the ``skin`` surface; an error for one clearly off it."""
+    on_skin = np.isin([src.feature_points[i] for i in ids], src.parts["skin"].vertex_ids)
     dist = np.zeros(len(ids))
     if on_skin.any():
         dist[on_skin] = closest_points(skin, points[on_skin]).distance

@@ -75,8 +75,12 @@ def _local(ids: np.ndarray, n: int) -> np.ndarray:
 
 def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
                   landmark_vertices: Mapping[str, tuple[str, int]], *,
-                  min_cos: float = 0.5) -> Face:
+                  min_cos: float = 0.5, skin: Surface | None = None) -> Face:
     """A new Face on ``target`` (metres, face frame) from ``source`` through ``tps``.
+
+    skin: the target's skin already prepared by :func:`~facelib.engine.surface.surface`
+        (its vertices and triangles in the skin part's own numbering), to save building it
+        again.
 
     landmark_vertices: feature point -> (part, index within the target's part) for
         landmarks given as vertices: they keep exactly that vertex when the part is the
@@ -94,7 +98,7 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
             pos = target.vertices[ids]
             tris = target.part_triangles(name)
             block = _dense(warped[src.vertex_ids], src_tris, pos, tris, offset=offset,
-                           min_cos=min_cos)
+                           min_cos=min_cos, prepared=skin if name == "skin" else None)
             col = (target.colors[ids] if target.colors is not None else
                    block.match.interpolate(block.guide_surface,
                                            source.vertex_colors[src.vertex_ids]))
@@ -129,8 +133,8 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
 
 
 def _dense(warped: np.ndarray, src_tris: np.ndarray, pos: np.ndarray, tris: np.ndarray, *,
-           offset: int, min_cos: float) -> _Dense:
-    target_surface = surface(pos, tris)
+           offset: int, min_cos: float, prepared: Surface | None = None) -> _Dense:
+    target_surface = surface(pos, tris) if prepared is None else prepared
     projected = closest_points(target_surface, warped,
                                normals=vertex_normals(warped, src_tris), min_cos=min_cos)
     guide = projected.points
