@@ -31,6 +31,13 @@ AUTO_EXCLUDED = ("4.3", "4.4", "4.5", "4.6", "9.1", "9.2", "9.15",
 _DOT = (40, 220, 80)
 _HOLE_DEPTH = 0.08  # a hit this far (x the head's size) behind the median hit went through
 _SKIN = (0.87, 0.68, 0.57)  # the default head's skin colour (sRGB), for uncoloured meshes
+# eyelid points lie on the lid's rim: the way (image rows) from the opening to the lid
+_LIDS = {"3.1": -1.0, "3.2": -1.0, "3.3": 1.0, "3.4": 1.0}
+_WALK = 0.1  # how far (x the upper lid points' pixel distance) to walk toward the lid
+_JUMP = 0.03  # a step whose hit comes this far forward (x their distance) crosses the rim
+_CORNERS = ("8.3", "8.4")  # the mouth corners lie at the bottom of their fold
+_STENCIL = 0.04  # radius (x the lid points' pixel distance) of the rays about a corner
+_FOLD = 0.15  # a corner lies at most this far (x the lid points' distance) behind its hit
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,10 +100,12 @@ def _rays(pixels: np.ndarray, pose: np.ndarray, projection: np.ndarray, size: in
     return ends[0], direction / np.linalg.norm(direction, axis=1, keepdims=True)
 
 
-def _hits(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+def _hits(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray, *,
+          front: float | None = None) -> np.ndarray:
     """First hit of each ray on the mesh ``(n, 3)``; NaN where a ray misses.
 
-    Moller-Trumbore against every triangle (a few dozen rays: ``n x F`` tests).
+    Moller-Trumbore against every triangle (a few dozen rays: ``n x F`` tests). front:
+    the depth of the face's front (default: the median hit's), see :func:`_through_holes`.
     """
     corners = mesh.vertices[mesh.triangles]  # (F, 3, 3)
     a = corners[:, 0]
@@ -115,16 +124,16 @@ def _hits(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray) -> np.nda
         hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (dist > 0)
         if hit.any():
             out[k] = origin + direction * dist[hit].min()
-    return _through_holes(mesh, origins, directions, out)
+    return _through_holes(mesh, origins, directions, out, front=front)
 
 
 def _through_holes(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray,
-                   hits: np.ndarray) -> np.ndarray:
+                   hits: np.ndarray, *, front: float | None = None) -> np.ndarray:
     """Rays that slip through an opening (eye sockets without eyeballs, under the chin)
-    hit far behind the face: take the vertex nearest to such a ray instead, among those no
-    deeper than the face's front."""
+    hit far behind the face's ``front`` (default: the median hit's depth): take the
+    vertex nearest to such a ray instead, among those no deeper than that."""
     depth = np.einsum("nc,nc->n", hits - origins, directions)
-    front = float(np.nanmedian(depth))
+    front = float(np.nanmedian(depth)) if front is None else front
     extent = float(np.ptp(mesh.vertices[mesh.parts["skin"]], axis=0).max())
     out = hits.copy()
     for k in np.flatnonzero(~(depth <= front + _HOLE_DEPTH * extent)):
@@ -172,10 +181,104 @@ def detect_head_landmarks(mesh: HeadMesh, *, size: int = 640,
     if ok.sum() < 4:
         raise FaceModelError(f"{mesh.name}: only {int(ok.sum())} feature points found on the "
                              "mesh; give landmarks by hand")
-    return HeadLandmarks(
-        points={fp: hit[k] for k, fp in enumerate(wanted) if ok[k]},
-        pixels={fp: pixels[rows[k]] for k, fp in enumerate(wanted) if ok[k]},
-        image=image)
+    front = float(np.nanmedian(np.einsum("nc,nc->n", hit - origins, directions)))
+    points, where = _refined(
+        mesh, {fp: hit[k] for k, fp in enumerate(wanted) if ok[k]},
+        {fp: pixels[rows[k]] for k, fp in enumerate(wanted) if ok[k]},
+        camera=(pose, projection, size), front=front)
+    return HeadLandmarks(points=points, pixels=where, image=image)
+
+
+def _refined(mesh: HeadMesh, points: dict[str, np.ndarray], pixels: dict[str, np.ndarray],
+             *, camera: tuple[np.ndarray, np.ndarray, int], front: float
+             ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The points after :func:`_settle` and :func:`_on_profile`, and their pixels (those
+    of the moved points projected again, so that the picture shows where they ended up)."""
+    moved = _settle(mesh, pixels, points, camera=camera, front=front)
+    moved.update(_on_profile(mesh, {**points, **moved}))
+    where = dict(pixels)
+    if moved:
+        pose, projection, size = camera
+        at = _project(np.array(list(moved.values())), pose, projection, size)
+        where.update(zip(moved, at, strict=True))
+    return {**points, **moved}, where
+
+
+def _settle(mesh: HeadMesh, pixels: dict[str, np.ndarray], points: dict[str, np.ndarray],
+            *, camera: tuple[np.ndarray, np.ndarray, int], front: float
+            ) -> dict[str, np.ndarray]:
+    """Eyelid points moved onto their lid's rim and mouth corners into their fold.
+
+    A lid point's pixel may fall just inside the eye opening, where the ray meets the
+    socket behind the lid: walking from it toward the lid (up for the upper lids, down for
+    the lower ones, up to :data:`_WALK` of the lid points' pixel distance), the first step
+    whose hit comes forward by more than :data:`_JUMP` (x their distance) is the rim, and
+    its hit the point. A corner's pixel may fall on the cheek in front of the fold: the
+    deepest hit within :data:`_STENCIL` of its pixel (at most :data:`_FOLD` behind the
+    nearest) is the corner. Rays through an opening (far behind the face) do not count.
+    """
+    if not all(k in pixels for k in ("3.1", "3.2")):
+        return {}
+    spread = float(np.linalg.norm(pixels["3.1"] - pixels["3.2"]))
+    size3d = float(np.linalg.norm(points["3.1"] - points["3.2"]))
+    behind = front + _HOLE_DEPTH * float(np.ptp(mesh.vertices[mesh.parts["skin"]], axis=0).max())
+    out = {}
+    for fp, way in _LIDS.items():
+        if fp in pixels:
+            steps = np.arange(0, int(np.ceil(_WALK * spread)) + 1)[:, None] * [0.0, way]
+            hits, depth = _raw_hits(mesh, pixels[fp] + steps, camera, behind)
+            depth = np.where(np.isnan(depth), np.inf, depth)  # through the opening
+            with np.errstate(invalid="ignore"):
+                jump = np.flatnonzero((depth[:-1] - depth[1:] > _JUMP * size3d)
+                                      & np.isfinite(depth[1:]))
+            if jump.size:
+                out[fp] = hits[jump[-1] + 1]
+    radius = _STENCIL * spread
+    grid = np.arange(-np.ceil(radius), np.ceil(radius) + 1)
+    disc = np.array([(a, b) for a in grid for b in grid if a * a + b * b <= radius * radius])
+    for fp in _CORNERS:
+        if fp in pixels:
+            hits, depth = _raw_hits(mesh, pixels[fp] + disc, camera, behind)
+            if not np.isnan(depth).all():
+                limit = float(np.nanmin(depth)) + _FOLD * size3d
+                out[fp] = hits[int(np.nanargmax(np.where(depth <= limit, depth, np.nan)))]
+    return out
+
+
+def _raw_hits(mesh: HeadMesh, pixels: np.ndarray, camera: tuple[np.ndarray, np.ndarray, int],
+              behind: float) -> tuple[np.ndarray, np.ndarray]:
+    """First hits ``(n, 3)`` of the rays through ``pixels (n, 2)`` and their depths ``(n,)``
+    along the ray (NaN for a miss or a hit deeper than ``behind``)."""
+    pose, projection, size = camera
+    origins, directions = _rays(pixels, pose, projection, size)
+    hits = _hits(mesh, origins, directions, front=np.inf)
+    depth = np.einsum("nc,nc->n", hits - origins, directions)
+    depth[~(depth <= behind)] = np.nan
+    return hits, depth
+
+
+def _on_profile(mesh: HeadMesh, points: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The found points of :data:`~facelib.tracking.profile.PROFILE_POINTS` placed again
+    from the mesh's midline profile (:mod:`facelib.tracking.profile`)."""
+    from facelib.engine import default_face
+    from facelib.tracking.profile import PROFILE_POINTS, profile_points
+
+    wanted = [k for k in PROFILE_POINTS if k in points]
+    if not wanted or not all(k in points for k in ("3.1", "3.2", "8.1", "8.2")):
+        return {}
+    src = default_face()
+    source = (src.vertices.astype(np.float64), src.parts["skin"].triangles,
+              {k: src.vertices[v].astype(np.float64) for k, v in src.feature_points.items()})
+    placed = profile_points(mesh.vertices, mesh.triangles, points, source=source)
+    return {k: placed[k] for k in wanted}
+
+
+def _project(points: np.ndarray, pose: np.ndarray, projection: np.ndarray, size: int
+             ) -> np.ndarray:
+    """Pixels ``(n, 2)`` (column, row) of ``points (n, 3)`` (the inverse of :func:`_rays`)."""
+    clip = np.c_[points, np.ones(len(points))] @ (projection @ np.linalg.inv(pose)).T
+    ndc = clip[:, :2] / clip[:, 3:4]
+    return np.c_[(ndc[:, 0] + 1) * size / 2, (1 - ndc[:, 1]) * size / 2]
 
 
 def draw_landmarks(found: HeadLandmarks) -> np.ndarray:

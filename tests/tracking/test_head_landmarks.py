@@ -40,19 +40,22 @@ def _errors(name: str, suffix: str) -> tuple[np.ndarray, object]:
 def test_soma_head_landmarks_within_3_mm() -> None:
     err, found = _errors("soma", "ply")
     assert len(err) >= 15
-    assert np.median(err) <= 3e-3
+    assert np.median(err) <= 3e-3  # measured 1.93 mm
     picture = draw_landmarks(found)  # type: ignore[arg-type]
     assert picture.shape == found.image.shape  # type: ignore[attr-defined]
     assert (picture != found.image).any()  # type: ignore[attr-defined]
 
 
-def test_cartoon_head_landmarks() -> None:
-    # MediaPipe's face model does not follow the cartoon's long chin: 2.1 and 2.10 land
-    # 31-38 mm above the true chin, and the wide mouth's corners about 5 mm inside; the
-    # median misses the 3 mm goal (measured 4.2 mm)
-    err, _ = _errors("cartoon", "obj")
-    assert np.median(err) <= 4.5e-3
-    assert np.sort(err)[-3] <= 7e-3
+def test_cartoon_head_landmarks_within_3_mm() -> None:
+    # MediaPipe puts the long chin's 2.1 and 2.10 31-38 mm too high; the midline profile
+    # places them (and 9.3, 8.2) from the mesh's shape, the lid points snap onto their
+    # rim and the mouth corners into their fold (measured median 2.84 mm, before 4.2 mm)
+    err, found = _errors("cartoon", "obj")
+    assert len(err) >= 18
+    assert np.median(err) <= 3e-3
+    truth = read_landmarks(HEADS / "cartoon_landmarks.json")
+    assert np.linalg.norm(found.points["2.1"] - truth["2.1"]) <= 3e-3  # type: ignore[attr-defined]
+    assert np.sort(err)[-3] <= 6e-3
 
 
 def test_auto_landmarks_set_up_a_face() -> None:
