@@ -3,8 +3,11 @@
 The mesh is rendered from the front with facelib's renderer, MediaPipe's face mesh finds
 its 478 landmarks in the picture, the packaged table maps them to MPEG-4 feature points
 (:mod:`facelib.tracking.layouts`), and a ray from the camera through each feature point's
-pixel is cast back onto the mesh; the first hit is the landmark. The mesh must look along
-+z with +y up (any unit).
+pixel is cast back onto the mesh; the first hit is the landmark. The mesh's own shape
+then corrects what a face model trained on people misplaces on other faces: eyelid points
+snap onto their lid's rim and mouth corners into their fold (:func:`_settle`), and the
+nose tip, lower lip and chin points are placed on the midline profile
+(:mod:`facelib.tracking.profile`). The mesh must look along +z with +y up (any unit).
 
 Feature points whose MediaPipe position follows another convention than the default head's
 (mid and outer brows 4.3-4.6 on the brow's upper edge, nostrils 9.1/9.2, 9.15) and the
