@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -51,11 +52,12 @@ def test_a_lid_that_closes_is_left_alone_and_a_weak_one_is_raised(source) -> Non
 
     full = float(rigid.hinge_angle(source.vertices[source.feature_points["3.1"]], centre,
                                    np.array([-1024 * source.fapu["IRISD"]]))[0])
-    kwargs = dict(vertices=source.vertices, triangles=source.parts["skin"].triangles,
-                  centre=centre, radius=radius, full_angle=full)
-    assert close_upper_lid(lid, **kwargs) is lid
+    fit = functools.partial(close_upper_lid, vertices=source.vertices,
+                            triangles=source.parts["skin"].triangles, centre=centre,
+                            radius=radius, full_angle=full)
+    assert fit(lid) is lid
     weak = dataclasses.replace(lid, weights=(lid.weights * 0.6).astype(np.float32))
-    fixed = close_upper_lid(weak, **kwargs)
+    fixed = fit(weak)
     assert np.all(fixed.weights >= weak.weights)
     assert fixed.weights.max() > weak.weights.max()
     closed = source.vertices.astype(np.float64).copy()

@@ -55,6 +55,6 @@ def test_the_profile_runs_down_the_face(source) -> None:  # type: ignore[no-unty
     assert gaps.max() <= scale / 120 * (1 + 1e-6)
     assert profile.points[0, 1] > points["9.3"][1] > profile.points[profile.below, 1]
     assert abs(profile.theta[profile.nearest(points["9.3"])]) < 30  # the tip looks forward
-    with pytest.raises(FaceModelError, match="needs feature points 8.1"):
+    with pytest.raises(FaceModelError, match=r"needs feature points 8\.1"):
         profile_points(vertices, triangles, {k: v for k, v in points.items() if k != "8.1"},
                        source=source)
