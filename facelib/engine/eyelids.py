@@ -9,7 +9,8 @@ centre and radius, the skin triangles in front of it), and in every column ``x``
 closed lid still shows the eyeball, the lid's weight at its rim (the skin just above the
 opening's top edge) is raised to the share of the full angle that turns the rim down to the
 opening's bottom edge, and the members around the rim by the same amount fading out
-(raised cosine) over half the eyeball's radius. Where the lid already closes, nothing
+(raised cosine) over half the eyeball's radius; the lid is closed again and this repeats
+(at most three rounds) while the eyeball shows. Where the lid already closes, nothing
 changes (a transfer onto the source itself stays exact).
 """
 
@@ -135,6 +136,7 @@ def close_upper_lid(region: Region, *, vertices: np.ndarray, triangles: np.ndarr
         still = eye_opening(closed, triangles, centre, radius)
         field = np.zeros(len(pos))
         field[members] = weights
+        # columns without a rim (-1) index the last triangle here; _lift skips them
         lift = _lift(opening, np.isfinite(still.high), pos[triangles[opening.rim]],
                      field[triangles[opening.rim]], members=pos[members], centre=centre,
                      full_angle=full_angle, reach=radius / 2)

@@ -117,7 +117,7 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         ids = source.parts[name].vertex_ids
         part_of[ids] = name
         local_of[ids] = np.arange(ids.size)
-    mapper = _Mapper(blocks, part_of, local_of)
+    mapper = _Mapper(blocks, part_of, local_of, warped)
     points = mapper.feature_points(source.feature_points, landmark_vertices)
     pivots = _pivots(source, tps, blocks, positions)
     verts = np.concatenate(positions)
@@ -217,10 +217,23 @@ class _Mapper:
     """Maps source vertex sets and fields onto the output mesh, part by part."""
 
     def __init__(self, blocks: Mapping[str, object], part_of: np.ndarray,
-                 local_of: np.ndarray):
+                 local_of: np.ndarray, warped: np.ndarray):
         self.blocks = blocks
         self.part_of = part_of
         self.local_of = local_of
+        self.warped = warped  # (V, 3) the source's vertices through the warp
+
+    def around(self, block: _Dense, sub: np.ndarray) -> np.ndarray:
+        """Local ids of the target part's vertices within the warped extent of the source
+        vertices ``sub`` (their centroid's and largest distance from it, through the warp),
+        or the 8 nearest to that centroid when the ball holds fewer than 2."""
+        pts = self.warped[sub]
+        centre = pts.mean(axis=0)
+        found = np.asarray(block.tree.query_ball_point(
+            centre, float(np.linalg.norm(pts - centre, axis=1).max())), np.int64)
+        if found.size < 2:
+            found = np.atleast_1d(block.tree.query(centre, k=min(8, block.tree.n))[1])
+        return np.unique(found).astype(np.int64)
 
     def _by_part(self, ids: np.ndarray) -> dict[str, np.ndarray]:
         parts = self.part_of[ids]
@@ -283,8 +296,8 @@ class _Mapper:
             indicator[self.local_of[sub]] = 1.0
             inside = block.match.interpolate(block.guide_surface, indicator)
             keep = np.flatnonzero(inside >= 0.5)
-            if not keep.size:  # a region too small for this mesh: its nearest vertices
-                keep = np.unique(self.nearest(sub)) - block.offset
+            if keep.size < min(2, sub.size):  # too small for this mesh, or carried onto
+                keep = self.around(block, sub)  # next to nothing (far from the landmarks)
             members.append(block.offset + keep)
             if region.weights.size:
                 field = np.zeros(block.guide.shape[0])

@@ -68,6 +68,19 @@ def test_auto_landmarks_set_up_a_face() -> None:
     assert 8e-3 < face.fapu["MNS"] * 1024 < 16e-3
 
 
+def test_auto_landmarks_set_up_the_cartoon() -> None:
+    """Without ear landmarks the warp carries the cartoon's small ear regions onto next to
+    nothing (ear_back_r onto its feature point alone, which failed the set-up): such a
+    region takes the target vertices around where the warp puts it."""
+    mesh = load_head_mesh(HEADS / "cartoon_head.obj")
+    face = set_up_face(mesh, landmarks=detect_head_landmarks(mesh).as_json()).face
+    for region in face.regions:
+        assert region.vertices.size >= 2, region.name
+    ears = {r.name: r for r in face.regions}["ear_back_r"]
+    fp = face.vertices[face.feature_points["10.4"]]
+    assert np.linalg.norm(face.vertices[ears.vertices] - fp, axis=1).max() > 1e-3
+
+
 def test_no_face_in_the_front_view() -> None:
     sphere = __import__("trimesh").creation.icosphere(subdivisions=3, radius=0.1)
     mesh = head_mesh(np.asarray(sphere.vertices), np.asarray(sphere.faces), name="ball")
