@@ -40,6 +40,7 @@ __all__ = ["transfer_face"]
 # a target eyeball centred this far (x its radius) from the warped source eye centre
 # rotates about its own centre (sphere fit) instead
 _EYE_CENTRE_TOLERANCE = 0.05
+_EYE_LIDS = {"eye_l": ("3.1", "3.3"), "eye_r": ("3.2", "3.4")}  # upper, lower lid points
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,11 +147,35 @@ def _dense(warped: np.ndarray, src_tris: np.ndarray, pos: np.ndarray, tris: np.n
 
 def _carry(source: Face, name: str, tps: ThinPlateSpline, warped: np.ndarray) -> np.ndarray:
     ids = source.parts[name].vertex_ids
-    if name in ("eye_l", "eye_r"):
+    if name in _EYE_LIDS:
         centre = source.pivots[name]
         scale = abs(float(np.linalg.det(tps.jacobian(centre)[0]))) ** (1 / 3)
-        return tps(centre)[0] + scale * (source.vertices[ids].astype(np.float64) - centre)
+        return (_eye_centre(source, name, tps)
+                + scale * (source.vertices[ids].astype(np.float64) - centre))
     return warped[ids]
+
+
+def _eye_centre(source: Face, name: str, tps: ThinPlateSpline) -> np.ndarray:
+    """``T(centre)`` of a carried eyeball (3,), placed against the warped upper and lower
+    lid points as the source's lies against its own: its height at the same share of the
+    way from the lower to the upper lid point, its depth the same distance behind their
+    mean, times the warp's local scale (as the eyeball's radius). A warp with few landmarks
+    about the eye (automatic ones, without pupils) may otherwise sink the eyeball in its
+    opening or push it through the lids, and the closed lids would not cover it."""
+    centre = source.pivots[name].astype(np.float64)
+    moved = tps(centre)[0]
+    if not all(k in source.feature_points for k in _EYE_LIDS[name]):
+        return moved
+    upper, lower = (source.vertices[source.feature_points[k]].astype(np.float64)
+                    for k in _EYE_LIDS[name])
+    if abs(upper[1] - lower[1]) < 1e-12:
+        return moved
+    share = (centre[1] - lower[1]) / (upper[1] - lower[1])
+    up, low = tps(np.vstack([upper, lower]))
+    scale = abs(float(np.linalg.det(tps.jacobian(centre)[0]))) ** (1 / 3)
+    moved[1] = low[1] + share * (up[1] - low[1])
+    moved[2] = (up[2] + low[2]) / 2 - scale * ((upper[2] + lower[2]) / 2 - centre[2])
+    return moved
 
 
 def _part_ranges(positions: list[np.ndarray]) -> dict[str, np.ndarray]:
@@ -165,7 +190,9 @@ def _pivots(source: Face, tps: ThinPlateSpline, blocks: Mapping[str, object],
             positions: list[np.ndarray]) -> dict[str, np.ndarray]:
     out = {name: tps(p)[0] for name, p in source.pivots.items()}
     for k, name in enumerate(PART_NAMES[1:3], start=1):
-        if isinstance(blocks[name], _Dense):  # the target's own eyeball
+        if not isinstance(blocks[name], _Dense):  # carried: about its placed centre
+            out[name] = _eye_centre(source, name, tps)
+        else:  # the target's own eyeball
             centre, radius = _sphere(positions[k])
             if np.linalg.norm(out[name] - centre) > _EYE_CENTRE_TOLERANCE * radius:
                 out[name] = centre

@@ -66,6 +66,22 @@ def test_auto_landmarks_set_up_a_face() -> None:
     # the lips part where they should: the inner upper lip above the inner lower lip
     assert face.vertices[fp["2.2"], 1] > face.vertices[fp["2.3"], 1]
     assert 8e-3 < face.fapu["MNS"] * 1024 < 16e-3
+    # the carried eyeballs sit in their openings (placed against the lid points, not
+    # sunk by a warp without pupils): closed lids hide the sclera (white pixels)
+    from facelib.rendering.scene import FaceRenderer
+
+    lids = face.vertices[[fp[k] for k in ("3.1", "3.2", "3.3", "3.4")]]
+    side = np.array([0.014, 0.0, 0.0])
+    closed = np.zeros(84, np.float32)
+    closed[[18, 19]] = 1024
+    white = []
+    with FaceRenderer(face, width=400, height=150,
+                      framing=np.vstack([lids + side, lids - side])) as renderer:
+        for values in (np.zeros(84, np.float32), closed):
+            image = renderer.frame(face.deform_frame(values)).astype(int)
+            white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
+    assert white[0] > 500
+    assert white[1] < 0.01 * white[0]
 
 
 def test_auto_landmarks_set_up_the_cartoon() -> None:
