@@ -62,6 +62,10 @@ TONGUE_DROP_DEG, TONGUE_BACK = 6.0, 0.05  # lowering the tongue (degrees, decime
 SCLERA = (0.93, 0.91, 0.88)  # off-white; the lids' shadow on it is baked occlusion
 IRIS = (0.30, 0.45, 0.55)
 IRIS_IN = (0.42, 0.50, 0.46)  # the collarette round the pupil: lighter, a little green
+# the upper lid's soft shadow on the eye: from LID_SHADOW[0] to LID_SHADOW[1] eye radii
+# above the eye's centre (the resting lid margin is at about 0.33) sclera and iris darken
+# smoothly to LID_SHADOW[2] times their colour
+LID_SHADOW = (0.0, 0.36, 0.62)
 IRIS_RIM = (0.12, 0.18, 0.22)
 PUPIL = (0.02, 0.02, 0.02)
 TEETH = (0.93, 0.91, 0.84)
@@ -195,6 +199,10 @@ def eye_sphere(centre: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarra
             cols.append(colours.get(i, SCLERA))
     verts.append(centre - [0, 0, radius])
     cols.append(SCLERA)
+    up = np.clip((np.array(verts)[:, 1] - centre[1]) / radius - LID_SHADOW[0], 0.0, None)
+    t = np.clip(up / (LID_SHADOW[1] - LID_SHADOW[0]), 0.0, 1.0)
+    shade = 1.0 - (1.0 - LID_SHADOW[2]) * t * t * (3 - 2 * t)
+    cols = list(np.array(cols) * shade[:, None])
     n_rings = len(polar) - 2
     tris = [[0, 1 + j, 1 + (j + 1) % n_lon] for j in range(n_lon)]
     for r in range(n_rings - 1):

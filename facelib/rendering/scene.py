@@ -70,6 +70,7 @@ class Look:
     shading: Mapping[str, float] = field(default_factory=lambda: {"wrap": 0.0,
                                                                   "specular": 0.04})
     occlusion: float = 1.0
+    occlusion_power: float = 1.0
     supersample: int = 2
 
     def material(self, part: str) -> Mapping[str, float]:
@@ -91,6 +92,7 @@ def load_look() -> Look:
         shading=MappingProxyType({k: float(v) for k, v in raw["shading"].items()
                                   if not k.startswith("_")}),
         occlusion=float(raw["occlusion"]["strength"]),
+        occlusion_power=float(raw["occlusion"]["power"]),
         supersample=int(raw["antialias"]["supersample"]),
     )
 
@@ -284,11 +286,13 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
-def _occluded(linear: np.ndarray, occlusion: Any, strength: float) -> np.ndarray:
+def _occluded(linear: np.ndarray, occlusion: Any, strength: float,
+              power: np.ndarray | float = 1.0) -> np.ndarray:
     """Linear colours ``(V, 3)`` darkened by baked ambient occlusion.
 
     ``occlusion`` is ``(V,)`` in [0, 1] (1 = open sky, ``Face.vertex_ao``) or None (no
-    darkening); each colour is multiplied by ``1 - strength * (1 - occlusion)``.
+    darkening); each colour is multiplied by ``1 - strength * (1 - occlusion ** power)``
+    (``power`` a number or ``(V,)``).
     """
     if occlusion is None:
         return linear
@@ -296,7 +300,7 @@ def _occluded(linear: np.ndarray, occlusion: Any, strength: float) -> np.ndarray
     if occlusion.shape != (len(linear),):
         raise FaceModelError(f"face vertex_ao must have shape ({len(linear)},), "
                              f"got {occlusion.shape}")
-    factor = 1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0))
+    factor = 1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0) ** power)
     return (linear * factor[:, None]).astype(np.float32)
 
 
@@ -447,8 +451,13 @@ class FaceRenderer:
         self._triangles = triangles
         self._normal_op = normal_operator(self.n_vertices, triangles)
         self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
+        default_power = self.look.occlusion_power
+        power = np.full(len(vertices), default_power, np.float32)
+        for piece in self._pieces:  # a part may set its own (the eyes)
+            spec = self.look.material(piece.name)
+            power[piece.vertex_ids] = float(spec.get("occlusion_power", default_power))
         linear = _occluded(_srgb_to_linear(colors), getattr(face, "vertex_ao", None),
-                           self.look.occlusion)
+                           self.look.occlusion, power)
         self._colors = [
             np.hstack([linear[p.vertex_ids], np.ones((len(p.vertex_ids), 1), np.float32)])
             for p in self._pieces
