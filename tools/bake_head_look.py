@@ -49,6 +49,9 @@ POSES = {"neutral": {}, "open jaw": {"open_jaw": 700.0}}  # FAP values (FAP unit
 # against the cavity, which stays dark. The power steepens the fall toward the back.
 RELATIVE_PARTS = ("teeth_upper", "teeth_lower", "tongue")
 RELATIVE_PERCENTILE, RELATIVE_POWER = 98.0, 1.5
+# The tongue leaves the mouth (tongue out, FAP 43-44): its top, deep under the palate at
+# rest, must not turn black outside, so it keeps at least this much.
+RELATIVE_FLOOR = {"tongue": 0.3}
 
 
 # ----------------------------------------------------------------------------- skin tone
@@ -209,7 +212,8 @@ def occlusion(face) -> np.ndarray:
     for name in RELATIVE_PARTS:
         ids = face.parts[name].vertex_ids
         top = max(float(np.percentile(ao[ids], RELATIVE_PERCENTILE)), 1e-3)
-        ao[ids] = np.clip(ao[ids] / top, 0.0, 1.0) ** RELATIVE_POWER
+        floor = RELATIVE_FLOOR.get(name, 0.0)
+        ao[ids] = floor + (1.0 - floor) * np.clip(ao[ids] / top, 0.0, 1.0) ** RELATIVE_POWER
     return ao
 
 
