@@ -4,7 +4,10 @@ and the time to turn a 10 s ``.fap`` into an MP4 relative to its duration.
 Run: ``PYTHONPATH=. python benchmarks/render_speed.py [--platform osmesa|egl] [--size 640x480]
 [--antialias auto|msaa|supersample|off]`` (the platform must be chosen before OpenGL loads, so
 each platform is its own run). The anti-aliasing mode (``FaceRenderer(antialias=...)``)
-applies to every figure; the line per mesh update names the mode in use.
+applies to every figure; the line per mesh update names the mode in use. The CPU time a frame
+(all threads of the process, llvmpipe's included) varies less with other jobs on a shared
+machine than the wall time does: on two idle cores a frame takes between half of it (both
+cores busy rendering) and all of it.
 """
 
 from __future__ import annotations
@@ -69,10 +72,12 @@ def main() -> None:
             update = _timed(lambda i, r=r: r.set_vertices(vertices[i % len(vertices)]),
                             args.frames)
             draw = _timed(lambda i, r=r: r.frame(), args.frames // 2)
+            cpu_start = time.process_time()  # all threads of this process (llvmpipe's too)
             both = _timed(lambda i, r=r: r.frame(vertices[i % len(vertices)]), args.frames)
+            cpu = (time.process_time() - cpu_start) / args.frames
         print(f"mesh update '{method}' ({r.antialias}): set_vertices {update * 1e3:6.2f} ms, "
               f"render only {draw * 1e3:6.1f} ms, update+render {both * 1e3:6.1f} ms "
-              f"= {1 / both:5.1f} frames/s")
+              f"= {1 / both:5.1f} frames/s; CPU {cpu * 1e3:.1f} ms a frame")
 
     deform = _timed(lambda i: face.deform(stream[i * 32 : i * 32 + 32]), 4) / 32
     print(f"face.deform: {deform * 1e3:.2f} ms per frame (in chunks of 32)")
