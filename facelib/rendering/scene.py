@@ -58,7 +58,14 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Look:
-    """Materials, lights and camera settings (see ``facelib/data/render_look.json``)."""
+    """Materials, lights, shading, occlusion, anti-aliasing and camera settings (see
+    ``facelib/data/render_look.json``).
+
+    ``shading``: ``wrap`` and ``specular`` of the face shader; ``occlusion`` and
+    ``occlusion_power``: how the baked ambient occlusion darkens colours (a part's material
+    may set its own ``occlusion_power``); ``supersample``: the factor of the fallback
+    anti-aliasing.
+    """
 
     parts: Mapping[str, Mapping[str, float]]
     lights: tuple[Mapping[str, Any], ...]
