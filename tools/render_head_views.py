@@ -53,7 +53,9 @@ def render(face, positions, *, side: bool = False, size: int = 420, zoom: float 
     import pyrender
     import trimesh
 
-    colours = (face.vertex_colors * 255).astype(np.uint8)
+    # the baked ambient occlusion, as facelib's renderer multiplies it in (linearly here)
+    ao = np.ones(len(face.vertices)) if face.vertex_ao is None else face.vertex_ao
+    colours = (face.vertex_colors * ao[:, None] * 255).astype(np.uint8)
     mesh = trimesh.Trimesh(positions, face.triangles, vertex_colors=colours, process=False)
     scene = pyrender.Scene(ambient_light=[0.35, 0.35, 0.35], bg_color=[0.2, 0.22, 0.26, 1])
     scene.add(pyrender.Mesh.from_trimesh(mesh, smooth=True))

@@ -102,6 +102,7 @@ class _Reader:
         self.doc = doc
         self.overrides = overrides
         self.fields: dict[str, np.ndarray] = {}  # the mesh file's field_* arrays
+        self.occlusion: np.ndarray | None = None  # the mesh file's vertex_ao, if any
 
     def fail(self, message: str) -> FaceModelError:
         return FaceModelError(message, path=self.path)
@@ -130,7 +131,7 @@ class _Reader:
         try:
             return Face.build(vertices=vertices, triangles=triangles, vertex_colors=colours,
                               parts=parts, feature_points=points, regions=regions, pivots=pivots,
-                              neck=neck)
+                              neck=neck, vertex_ao=self.occlusion)
         except FaceModelError as exc:
             raise self.fail(exc.message) from exc
 
@@ -140,6 +141,7 @@ class _Reader:
             with np.load(mesh_path, allow_pickle=False) as data:
                 arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
                 self.fields = {k: data[k] for k in data.files if k.startswith("field_")}
+                occlusion = data["vertex_ao"] if "vertex_ao" in data.files else None
         except (OSError, ValueError) as exc:
             raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
         except KeyError as exc:
@@ -154,7 +156,18 @@ class _Reader:
         if c.shape != v.shape:
             raise self.fail(f"vertex_colors must have shape {v.shape}, got {c.shape}")
         c = c / 255.0 if np.issubdtype(c.dtype, np.integer) else c.astype(np.float64)
+        self.occlusion = None if occlusion is None else self.unit_values(occlusion, len(v))
         return v, t, np.clip(c, 0.0, 1.0)
+
+    def unit_values(self, values: np.ndarray, nv: int) -> np.ndarray:
+        """``vertex_ao`` as ``(V,) float`` in [0, 1] (uint8 0-255 or floats)."""
+        if values.shape != (nv,):
+            raise self.fail(f"vertex_ao must have shape ({nv},), got {values.shape}")
+        if np.issubdtype(values.dtype, np.integer):
+            return values / 255.0
+        if not np.all(np.isfinite(values)):
+            raise self.fail("vertex_ao must be finite")
+        return np.clip(values.astype(np.float64), 0.0, 1.0)
 
     def index(self, value: Any, nv: int, what: str) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < nv:

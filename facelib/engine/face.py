@@ -198,6 +198,8 @@ class Face:
         where head rotations fade out.
     operator: scipy CSR array (84, 3V) float32: vertex displacements (flattened ``(V, 3)``)
         per FAP unit, for every translational FAP that deforms linearly.
+    vertex_ao: (V,) float32 baked ambient occlusion in [0, 1] (1 = open sky), which the
+        renderer multiplies into the colours; None where the mesh file has none.
     """
 
     vertices: np.ndarray
@@ -214,6 +216,7 @@ class Face:
     _dense: np.ndarray = field(repr=False)
     _rigid: _Rigid = field(repr=False)
     _steps: tuple[_Step, ...] = field(repr=False, default=())
+    vertex_ao: np.ndarray | None = field(repr=False, default=None)
 
     @classmethod
     def build(
@@ -227,6 +230,7 @@ class Face:
         regions: tuple[Region, ...],
         pivots: Mapping[str, np.ndarray],
         neck: tuple[np.ndarray, np.ndarray, float],
+        vertex_ao: np.ndarray | None = None,
     ) -> Face:
         """Compile a face from validated pieces (see :func:`facelib.engine.load_face`).
 
@@ -267,6 +271,7 @@ class Face:
             _dense=dense,
             _rigid=rigid_parts,
             _steps=steps,
+            vertex_ao=None if vertex_ao is None else _readonly(vertex_ao, np.float32),
         )
 
     def __repr__(self) -> str:

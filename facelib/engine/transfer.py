@@ -89,11 +89,13 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
     """
     warped = tps(source.vertices.astype(np.float64))
     blocks: dict[str, _Dense | _Carried] = {}
-    positions, triangles, colours = [], [], []
+    positions, triangles, colours, occlusion = [], [], [], []
     offset = 0
+    source_ao = source.vertex_ao if source.vertex_ao is not None else np.ones(source.n_vertices)
     for name in PART_NAMES:
         src = source.parts[name]
         src_tris = _local(src.vertex_ids, source.n_vertices)[src.triangles]
+        ao = source_ao[src.vertex_ids]
         if name in target.parts and target.parts[name].size:
             ids = target.parts[name]
             pos = target.vertices[ids]
@@ -103,6 +105,7 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
             col = (target.colors[ids] if target.colors is not None else
                    block.match.interpolate(block.guide_surface,
                                            source.vertex_colors[src.vertex_ids]))
+            ao = block.match.interpolate(block.guide_surface, ao)  # baked on the source
             blocks[name] = block
         else:
             pos, tris = _carry(source, name, tps, warped), src_tris
@@ -111,6 +114,7 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         positions.append(pos)
         triangles.append(tris + offset)
         colours.append(col)
+        occlusion.append(ao)
         offset += len(pos)
     part_of = np.empty(source.n_vertices, dtype=object)
     local_of = np.zeros(source.n_vertices, np.int64)
@@ -130,7 +134,8 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         vertices=verts, triangles=np.concatenate(triangles),
         vertex_colors=np.clip(np.concatenate(colours), 0, 1),
         parts=parts, feature_points=points, regions=regions,
-        pivots=pivots, neck=_neck(source, tps))
+        pivots=pivots, neck=_neck(source, tps),
+        vertex_ao=None if source.vertex_ao is None else np.clip(np.concatenate(occlusion), 0, 1))
 
 
 def _dense(warped: np.ndarray, src_tris: np.ndarray, pos: np.ndarray, tris: np.ndarray, *,

@@ -83,6 +83,8 @@ def write_face(face: Face, path: str | Path, *, name: str = "", source: str = ""
     arrays: dict[str, np.ndarray] = {
         "vertices": face.vertices, "triangles": face.triangles,
         "vertex_colors": np.round(face.vertex_colors * 255).astype(np.uint8), **fields}
+    if face.vertex_ao is not None:
+        arrays["vertex_ao"] = np.round(face.vertex_ao * 255).astype(np.uint8)
     np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
     with atomic_path(mesh_path) as temp:
         temp.write_bytes(buffer.getvalue())

@@ -1,4 +1,5 @@
-"""glTF 2.0 export: the head with its vertex colours, sparse morph targets for the engine's
+"""glTF 2.0 export: the head with its vertex colours (the baked ambient occlusion multiplied
+in, as facelib's renderer does), sparse morph targets for the engine's
 linear basis, a skin for eyes, eyelids, jaw and head, and an animation of a FapStream.
 
 The container is built with pygltflib (``export`` extra). A frame of the animation evaluated
@@ -118,6 +119,21 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4).astype(np.float32)
 
 
+def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarray:
+    """``(V, 3)`` linear colours with the face's baked ambient occlusion multiplied in as
+    facelib's renderer does: ``1 - strength * (1 - ao ** power)`` (``render_look.json``
+    ``occlusion``; a part's material may set its own ``occlusion_power``)."""
+    if face.vertex_ao is None:
+        return linear
+    spec, out = look["occlusion"], linear.copy()
+    for name, part in face.parts.items():
+        material = look["parts"].get(name, look["parts"]["default"])
+        power = float(material.get("occlusion_power", spec["power"]))
+        ao = face.vertex_ao[part.vertex_ids] ** power
+        out[part.vertex_ids] *= (1.0 - float(spec["strength"]) * (1.0 - ao))[:, None]
+    return out
+
+
 def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(V, 3) float32 unit area-weighted vertex normals ((0, 0, 1) where undefined)."""
     v = vertices.astype(np.float64)
@@ -133,12 +149,13 @@ def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
     """One primitive per part; ``targets`` (T, V, 3) float32 displacements."""
     lib = b.lib
-    look = data.json_data("render_look.json")["parts"]
+    look_data = data.json_data("render_look.json")
+    look = look_data["parts"]
     normals = vertex_normals(face.vertices, face.triangles)
     # each target's change of the normals, so that players shade the deformed face right
     normal_turns = [vertex_normals(face.vertices + disp, face.triangles) - normals
                     for disp in targets]
-    colours = _srgb_to_linear(face.vertex_colors)
+    colours = _occluded(_srgb_to_linear(face.vertex_colors), face, look_data)
     joints = np.zeros((face.n_vertices, 4), np.uint16)
     joints[:, :2] = rig.joints
     weights = np.zeros((face.n_vertices, 4), np.float32)

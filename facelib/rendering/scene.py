@@ -8,8 +8,18 @@ in place with ``glBufferSubData`` (positions and the per-frame smooth normals), 
 cheapest correct update measured in ``benchmarks/render_mesh_update.py``. Swapping in new
 mesh nodes (``mesh_update="swap"``) is also correct but re-creates every buffer per frame.
 
-Everything that is a matter of taste (materials per part, lights, camera field of view,
-background) lives in ``facelib/data/render_look.json``.
+Everything that is a matter of taste (materials per part, lights, shading, ambient
+occlusion strength, anti-aliasing, camera field of view, background) lives in
+``facelib/data/render_look.json``. Faces are shaded by facelib's own shader
+(``facelib/data/shaders/face.vert``/``face.frag``: wrap diffuse plus normalised Blinn-Phong
+under the look's directional lights), which replaces pyrender's PBR shader for mesh
+primitives: it reads the same uniforms and costs about a third as much on llvmpipe.
+
+Anti-aliasing: pyrender renders into a 4x multisampled framebuffer only where its platform
+says it has framebuffers (EGL); its OSMesa platform says no, although Mesa's OSMesa contexts
+have them. :class:`FaceRenderer` turns that path on where ``GL_MAX_SAMPLES`` allows 4
+samples (``"msaa"``), and otherwise renders ``k`` times larger and averages ``k x k``
+blocks (``"supersample"``, ``k`` from the look).
 """
 
 from __future__ import annotations
@@ -29,10 +39,12 @@ from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
 
 __all__ = [
+    "ANTIALIAS",
     "FRAMINGS",
     "FaceRenderer",
     "Look",
     "PartMesh",
+    "downsample",
     "frame_camera",
     "framing_points",
     "load_look",
@@ -46,7 +58,14 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Look:
-    """Materials, lights and camera settings (see ``facelib/data/render_look.json``)."""
+    """Materials, lights, shading, occlusion, anti-aliasing and camera settings (see
+    ``facelib/data/render_look.json``).
+
+    ``shading``: ``wrap`` and ``specular`` of the face shader; ``occlusion`` and
+    ``occlusion_power``: how the baked ambient occlusion darkens colours (a part's material
+    may set its own ``occlusion_power``); ``supersample``: the factor of the fallback
+    anti-aliasing.
+    """
 
     parts: Mapping[str, Mapping[str, float]]
     lights: tuple[Mapping[str, Any], ...]
@@ -55,6 +74,11 @@ class Look:
     yfov_deg: float
     margin: float
     framings: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    shading: Mapping[str, float] = field(default_factory=lambda: {"wrap": 0.0,
+                                                                  "specular": 0.04})
+    occlusion: float = 1.0
+    occlusion_power: float = 1.0
+    supersample: int = 2
 
     def material(self, part: str) -> Mapping[str, float]:
         return self.parts.get(part, self.parts["default"])
@@ -72,11 +96,20 @@ def load_look() -> Look:
         yfov_deg=float(raw["camera"]["yfov_deg"]),
         margin=float(raw["camera"]["margin"]),
         framings=MappingProxyType(raw.get("framings", {})),
+        shading=MappingProxyType({k: float(v) for k, v in raw["shading"].items()
+                                  if not k.startswith("_")}),
+        occlusion=float(raw["occlusion"]["strength"]),
+        occlusion_power=float(raw["occlusion"]["power"]),
+        supersample=int(raw["antialias"]["supersample"]),
     )
 
 
 FRAMINGS = ("face", "head", "bust")
 """Named framings of :class:`FaceRenderer` (defined in ``render_look.json``)."""
+
+ANTIALIAS = ("auto", "msaa", "supersample", "off")
+"""Anti-aliasing modes of :class:`FaceRenderer`: ``"auto"`` takes 4x MSAA where the context
+has it and supersampling otherwise."""
 
 
 def framing_points(face: Any, name: str, *, look: Look | None = None) -> np.ndarray:
@@ -260,6 +293,24 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
+def _occluded(linear: np.ndarray, occlusion: Any, strength: float,
+              power: np.ndarray | float = 1.0) -> np.ndarray:
+    """Linear colours ``(V, 3)`` darkened by baked ambient occlusion.
+
+    ``occlusion`` is ``(V,)`` in [0, 1] (1 = open sky, ``Face.vertex_ao``) or None (no
+    darkening); each colour is multiplied by ``1 - strength * (1 - occlusion ** power)``
+    (``power`` a number or ``(V,)``).
+    """
+    if occlusion is None:
+        return linear
+    occlusion = np.asarray(occlusion, np.float32)
+    if occlusion.shape != (len(linear),):
+        raise FaceModelError(f"face vertex_ao must have shape ({len(linear)},), "
+                             f"got {occlusion.shape}")
+    factor = 1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0) ** power)
+    return (linear * factor[:, None]).astype(np.float32)
+
+
 def _face_arrays(face: Deformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     try:
         vertices = np.asarray(face.vertices, np.float32)
@@ -277,20 +328,28 @@ def _face_arrays(face: Deformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return vertices, triangles, colors
 
 
-def _stabilise_program_cache(pr: Any, offscreen: Any) -> None:
-    """Make pyrender reuse its compiled shaders on OSMesa.
+def _shader_file(name: str) -> str:
+    """Path of one of facelib's shaders (``facelib/data/shaders``)."""
+    return str(data.path(f"shaders/{name}"))
 
-    pyrender keys its shader cache by ``OpenGL.contextdata.getContext()``, which on OSMesa is
-    a fresh ctypes pointer object each call, so every frame missed the cache, recompiled
-    every shader and leaked the old programs (about 40% of the frame time at 640x480). A
-    renderer has exactly one context, so the cache here is keyed by shaders and defines only.
+
+def _install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
+    """Give pyrender's ``renderer`` (a ``pyrender.Renderer``) facelib's program cache.
+
+    It does two things. It serves facelib's face shader wherever pyrender asks for its
+    mesh shader, with the look's ``shading`` numbers as ``#define``s (upper-cased names).
+    And it keys compiled programs by shaders and defines only: pyrender keys its cache by
+    ``OpenGL.contextdata.getContext()``, which on OSMesa is a fresh ctypes pointer object
+    each call, so every frame missed the cache, recompiled every shader and leaked the old
+    programs (about 40% of the frame time at 640x480). A renderer has exactly one context.
     """
     base = pr.shader_program.ShaderProgramCache
-    inner = getattr(offscreen, "_renderer", None)
-    if inner is None or not isinstance(getattr(inner, "_program_cache", None), base):
+    old = getattr(renderer, "_program_cache", None)
+    if not isinstance(old, base):
         return
+    shading = {name.upper(): float(value) for name, value in look.shading.items()}
 
-    class _OneContextCache(base):  # type: ignore[valid-type,misc]  # pyrender is untyped
+    class _FaceProgramCache(base):  # type: ignore[valid-type,misc]  # pyrender is untyped
         def __init__(self, shader_dir: str | None = None):
             super().__init__(shader_dir=shader_dir)
             self._by_source: dict[tuple, Any] = {}
@@ -298,8 +357,14 @@ def _stabilise_program_cache(pr: Any, offscreen: Any) -> None:
         def get_program(self, vertex_shader: str, fragment_shader: str,
                         geometry_shader: str | None = None,
                         defines: dict | None = None) -> Any:
+            defines = dict(defines or {})
+            if (vertex_shader, fragment_shader, geometry_shader) == ("mesh.vert", "mesh.frag",
+                                                                     None):
+                vertex_shader, fragment_shader = _shader_file("face.vert"), _shader_file(
+                    "face.frag")
+                defines.update(shading)
             key = (vertex_shader, fragment_shader, geometry_shader,
-                   tuple(sorted((defines or {}).items())))
+                   tuple(sorted(defines.items())))
             program = self._by_source.get(key)
             if program is None:
                 program = super().get_program(vertex_shader, fragment_shader,
@@ -311,7 +376,31 @@ def _stabilise_program_cache(pr: Any, offscreen: Any) -> None:
             super().clear()
             self._by_source = {}
 
-    inner._program_cache = _OneContextCache(shader_dir=inner._program_cache.shader_dir)
+    renderer._program_cache = _FaceProgramCache(shader_dir=old.shader_dir)
+
+
+def downsample(image: np.ndarray, factor: int) -> np.ndarray:
+    """Average ``factor x factor`` pixel blocks: ``(H*k, W*k, C) uint8`` -> ``(H, W, C) uint8``.
+
+    A box filter on the 8-bit sRGB values (rounded to nearest), the cheap resolve of a
+    supersampled frame.
+    """
+    if factor == 1:
+        return image
+    h, w = image.shape[0] // factor, image.shape[1] // factor
+    blocks = image[: h * factor, : w * factor].reshape(h, factor, w, factor, -1)
+    total = blocks.sum(axis=(1, 3), dtype=np.uint32)
+    return ((total + factor * factor // 2) // (factor * factor)).astype(np.uint8)
+
+
+def _max_samples() -> int:
+    """``GL_MAX_SAMPLES`` of the current context (0 where the query fails)."""
+    from OpenGL import GL
+
+    try:
+        return int(GL.glGetIntegerv(GL.GL_MAX_SAMPLES))
+    except Exception:  # noqa: BLE001  # a context without the query has no MSAA
+        return 0
 
 
 # -- the renderer ------------------------------------------------------------------------
@@ -334,6 +423,10 @@ class FaceRenderer:
         frame height; ``"head"``; ``"bust"``) or ``(N, 3)`` points to frame the camera on.
     mesh_update: ``"buffers"`` rewrites vertex buffers in place (fast), ``"swap"`` replaces the
         mesh nodes each frame.
+    antialias: ``"auto"`` (4x MSAA where the context has it, else supersampling),
+        ``"msaa"``, ``"supersample"`` (render ``look.supersample`` times larger and average
+        blocks) or ``"off"``. pyrender always multisamples on EGL, whatever this says.
+        :attr:`antialias` tells the mode in use.
     """
 
     def __init__(
@@ -347,12 +440,15 @@ class FaceRenderer:
         look: Look | None = None,
         mesh_update: Literal["buffers", "swap"] = "buffers",
         offscreen: bool = True,
+        antialias: Literal["auto", "msaa", "supersample", "off"] = "auto",
     ):
         for label, value in (("width", width), ("height", height)):
             if not isinstance(value, (int, np.integer)) or not 8 <= value <= 8192:
                 raise ParameterError(f"{label} must be an integer in [8, 8192], got {value!r}")
         if mesh_update not in ("buffers", "swap"):
             raise ParameterError(f"mesh_update must be 'buffers' or 'swap', got {mesh_update!r}")
+        if antialias not in ANTIALIAS:
+            raise ParameterError(f"antialias must be one of {ANTIALIAS}, got {antialias!r}")
         self.width, self.height = int(width), int(height)
         self.mesh_update = mesh_update
         self.look = look or load_look()
@@ -362,7 +458,13 @@ class FaceRenderer:
         self._triangles = triangles
         self._normal_op = normal_operator(self.n_vertices, triangles)
         self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
-        linear = _srgb_to_linear(colors)
+        default_power = self.look.occlusion_power
+        power = np.full(len(vertices), default_power, np.float32)
+        for piece in self._pieces:  # a part may set its own (the eyes)
+            spec = self.look.material(piece.name)
+            power[piece.vertex_ids] = float(spec.get("occlusion_power", default_power))
+        linear = _occluded(_srgb_to_linear(colors), getattr(face, "vertex_ao", None),
+                           self.look.occlusion, power)
         self._colors = [
             np.hstack([linear[p.vertex_ids], np.ones((len(p.vertex_ids), 1), np.float32)])
             for p in self._pieces
@@ -376,19 +478,46 @@ class FaceRenderer:
         if isinstance(framing, str):
             framing = framing_points(face, framing, look=self.look)
         self.scene = self._build_scene(vertices, background, framing)
-        self._renderer = None
+        self._renderer: Any = None
+        self._scale = 1
+        self.antialias = "off"
         self._primitives: list[Any] = []
         self._nodes: list[Any] = []
         self.set_vertices(vertices)
         if offscreen:
-            try:
-                self._renderer = self._pr.OffscreenRenderer(self.width, self.height)
-            except Exception as exc:
-                raise RenderError(
-                    f"could not create a {self.width}x{self.height} offscreen OpenGL context "
-                    f"({type(exc).__name__}: {exc}); {INSTALL_HINT}"
-                ) from exc
-            _stabilise_program_cache(self._pr, self._renderer)
+            self._open(antialias)
+
+    def _context(self, scale: int) -> Any:
+        try:
+            renderer = self._pr.OffscreenRenderer(scale * self.width, scale * self.height)
+        except Exception as exc:
+            raise RenderError(
+                f"could not create a {scale * self.width}x{scale * self.height} offscreen "
+                f"OpenGL context ({type(exc).__name__}: {exc}); {INSTALL_HINT}"
+            ) from exc
+        _install_program_cache(self._pr, renderer._renderer, self.look)
+        return renderer
+
+    def _open(self, antialias: str) -> None:
+        """Create the offscreen context with the anti-aliasing ``antialias`` asks for."""
+        self._renderer = self._context(1)
+        platform = self._renderer._platform
+        platform.make_current()
+        # pyrender multisamples (4x) whenever its platform renders into framebuffers
+        has_msaa = platform.supports_framebuffers() or _max_samples() >= 4
+        mode = ("msaa" if has_msaa else "supersample") if antialias == "auto" else antialias
+        if mode == "msaa" and not has_msaa:
+            self.close()
+            raise RenderError("this OpenGL context has no 4x multisampling "
+                              "(GL_MAX_SAMPLES < 4); use antialias='supersample'")
+        if mode == "msaa" and not platform.supports_framebuffers():
+            # OSMesa: Mesa's contexts have framebuffer objects; pyrender's class says not
+            platform.supports_framebuffers = lambda: True
+        if mode == "supersample" and self.look.supersample > 1:
+            self._renderer.delete()
+            self._scale = self.look.supersample
+            self._renderer = self._context(self._scale)
+        self.antialias = mode
 
     # -- scene construction -----------------------------------------------------------
 
@@ -491,7 +620,7 @@ class FaceRenderer:
             color, _ = self._renderer.render(self.scene)
         except Exception as exc:
             raise RenderError(f"OpenGL rendering failed ({type(exc).__name__}: {exc})") from exc
-        return np.ascontiguousarray(color[:, :, :3], dtype=np.uint8)
+        return np.ascontiguousarray(downsample(color[:, :, :3], self._scale), dtype=np.uint8)
 
     def project(self, points: np.ndarray) -> np.ndarray:
         """Pixel coordinates ``(N, 2) float64`` (column, row; origin top-left) of ``(N, 3)``

@@ -74,6 +74,11 @@ def test_x1_identity_is_exact(source) -> None:  # type: ignore[no-untyped-def]
             np.testing.assert_allclose(mine.weights, theirs.weights[order], atol=1e-12)
     # (issue 14: the learned fields pass through the interpolation like weights: float noise)
     assert abs(face.operator - source.operator).max() <= 1e-12
+    # the baked ambient occlusion travels with the colours (issue 14, look)
+    assert face.vertex_ao is not None and source.vertex_ao is not None
+    # (exact but for a few tongue vertices that the correspondence interpolates)
+    diff = np.abs(face.vertex_ao - source.vertex_ao)
+    assert np.mean(diff < 1e-6) > 0.99 and diff.max() < 0.25
     for name in FRAMES:
         np.testing.assert_allclose(face.deform_frame(FRAMES[name]),
                                    source.deform_frame(FRAMES[name]), atol=1e-9)
@@ -283,6 +288,8 @@ def test_written_definition_round_trips(source, tmp_path: Path) -> None:  # type
     assert np.array_equal(again.vertices, source.vertices)
     assert dict(again.feature_points) == dict(source.feature_points)
     assert abs(again.operator - source.operator).max() == 0
+    assert again.vertex_ao is not None and source.vertex_ao is not None
+    assert np.abs(again.vertex_ao - source.vertex_ao).max() <= 0.5 / 255 + 1e-6  # uint8
     doc = json.loads(path.read_text())
     assert doc["mesh"] == "face.npz" and doc["name"] == "copy"
     original = json.loads((Path(__file__).resolve().parents[2] / "facelib" / "data" / "head"

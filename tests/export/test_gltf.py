@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from gltf_eval import Gltf, busy_stream
 
+from facelib.data import json_data
 from facelib.engine import default_face
 from facelib.export import export_gltf
 
@@ -37,6 +38,25 @@ def test_evaluated_gltf_matches_deform_within_a_tenth_of_a_millimetre(exported):
     print(f"worst {worst * 1000:.5f} mm")
     # the deformation is real: frame 6 moves the face by centimetres
     assert np.abs(want[6] - face.vertices).max() > 0.01
+
+
+def test_vertex_colours_carry_the_baked_occlusion(exported):
+    """COLOR_0 is the linear colour darkened by the ambient occlusion as the renderer does
+    it: deep in the mouth far darker than the colour alone, the open cheek unchanged."""
+    result, _ = exported
+    face = default_face()
+    gltf = Gltf(result.path)
+    skin = face.parts["skin"]
+    prim = next(m.primitives[0] for m in gltf.g.meshes
+                if len(gltf.accessor(m.primitives[0].attributes.POSITION)) == skin.vertex_ids.size)
+    colours = gltf.accessor(prim.attributes.COLOR_0)[:, :3]
+    rgb = np.clip(face.vertex_colors[np.sort(skin.vertex_ids)], 0, 1)
+    linear = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    ao = face.vertex_ao[np.sort(skin.vertex_ids)]
+    spec = json_data("render_look.json")["occlusion"]  # the skin has no power of its own
+    factor = 1 - spec["strength"] * (1 - ao ** spec["power"])
+    np.testing.assert_allclose(colours, linear * factor[:, None], atol=1e-5)
+    assert (colours[ao < 0.1] < 0.5 * linear[ao < 0.1] + 1e-6).all()
 
 
 def test_targets_are_sparse_and_only_what_the_stream_uses(exported):

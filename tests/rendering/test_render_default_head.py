@@ -39,9 +39,11 @@ def test_eyes_turned_left_move_the_iris_right_in_the_image(head, fap_frame):
         xs = []
         for cx, cy in centres:
             r0, c0 = int(cy) - 6, int(cx) - 10
-            patch = image[r0 : r0 + 12, c0 : c0 + 20].astype(int).sum(axis=2)
-            dark = patch < np.percentile(patch, 15)
-            xs.append(np.nonzero(dark)[1].mean() + c0)
+            patch = image[r0 : r0 + 12, c0 : c0 + 20].astype(int)
+            # the blue iris (the lids' occlusion darkens the eye corners too, so darkness
+            # alone no longer finds it)
+            iris = patch[..., 2] > patch[..., 0] + 15
+            xs.append(np.nonzero(iris)[1].mean() + c0)
         return float(np.mean(xs))
 
     x0 = iris_x(renderer.frame(face.deform_frame(fap_frame())))
@@ -111,7 +113,8 @@ def test_closed_lids_cover_the_whole_eye(fap_frame):
         white = []
         for values in (fap_frame(), closed):
             image = renderer.frame(face.deform_frame(values)).astype(int)
-            white.append(((image.min(2) > 170) & (np.ptp(image, axis=2) < 40)).sum())
+            # sclera: bright and grey (off-white, and darker in the lids' occlusion)
+            white.append(((image.min(2) > 140) & (np.ptp(image, axis=2) < 40)).sum())
     assert white[0] > 500
     assert white[1] < 0.03 * white[0]
 

@@ -1,0 +1,33 @@
+#version 330 core
+// facelib's face vertex shader: passes world-space position, normal and the per-vertex
+// colour (sRGB converted to linear, ambient occlusion already multiplied in) to face.frag.
+// Attribute locations and the M/V/P uniforms are the ones pyrender binds for any mesh.
+
+layout(location = 0) in vec3 position;
+layout(location = NORMAL_LOC) in vec3 normal;
+#ifdef COLOR_0_LOC
+layout(location = COLOR_0_LOC) in vec4 color_0;
+#endif
+layout(location = INST_M_LOC) in mat4 inst_m;
+
+uniform mat4 M;
+uniform mat4 V;
+uniform mat4 P;
+
+out vec3 world_position;
+out vec3 world_normal;
+out vec3 albedo;
+
+void main()
+{
+    mat4 model = M * inst_m;
+    vec4 world = model * vec4(position, 1.0);
+    gl_Position = P * V * world;
+    world_position = world.xyz;
+    world_normal = mat3(transpose(inverse(model))) * normal;
+#ifdef COLOR_0_LOC
+    albedo = color_0.rgb;
+#else
+    albedo = vec3(0.8);
+#endif
+}
