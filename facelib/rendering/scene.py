@@ -398,6 +398,7 @@ class FaceRenderer:
             baseColorFactor=(1.0, 1.0, 1.0, 1.0),
             metallicFactor=float(spec.get("metallic", 0.0)),
             roughnessFactor=float(spec.get("roughness", 0.6)),
+            doubleSided=bool(spec.get("double_sided", False)),
         )
 
     def _build_scene(
