@@ -494,6 +494,14 @@ class FaceRenderer:
             raise RenderError(f"OpenGL rendering failed ({type(exc).__name__}: {exc})") from exc
         return np.ascontiguousarray(color[:, :, :3], dtype=np.uint8)
 
+    def set_camera(self, pose: np.ndarray, *, znear: float, zfar: float) -> None:
+        """Move the camera to ``pose`` ``(4, 4)`` (camera to face coordinates) with these
+        clipping distances (storyboard camera cues; see :mod:`facelib.rendering.camera`)."""
+        node = self.scene.main_camera_node
+        node.camera.znear, node.camera.zfar = float(znear), float(zfar)
+        self.camera_pose = np.asarray(pose, np.float64)
+        self.scene.set_pose(node, self.camera_pose)
+
     def project(self, points: np.ndarray) -> np.ndarray:
         """Pixel coordinates ``(N, 2) float64`` (column, row; origin top-left) of ``(N, 3)``
         points in face coordinates, as this renderer's camera sees them."""
