@@ -38,9 +38,9 @@ UPPER_MIN_WEIGHT = 0.15  # front-rim vertices with at least this upper-lid weigh
 # that rises away from the eye (curl), width at the root and tip (m)
 LIDS = {
     "upper": {"spacing": 0.00034, "length": 0.0068, "peak": 0.40, "curl": 0.5,
-              "root": 0.00022, "tip": 0.00004},
+              "root": 0.00036, "tip": 0.00006},
     "lower": {"spacing": 0.00055, "length": 0.0028, "peak": 0.35, "curl": 0.2,
-              "root": 0.00016, "tip": 0.00003},
+              "root": 0.00024, "tip": 0.00004},
 }
 # the lower line: front-rim vertices between these angles (degrees about the eye centre, 0 =
 # toward the outer corner, -90 = straight down); lashes nearer the outer corner would stick

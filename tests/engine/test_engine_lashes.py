@@ -58,9 +58,10 @@ def test_lashes_follow_the_lid_margin_through_a_blink(face: Face, fap_frame,  # 
     ids = _lashes(face)
     margin_moves = _margin(face, moved) - _margin(face, rest)
     lash_moves = moved[ids] - rest[ids]
-    roots = ids.reshape(-1, RIBS)[:, :2].ravel() - ids[0]
-    # a root moves as its point of the margin does (to 0.05 mm, its offset off the skin)
-    assert np.abs(lash_moves[roots] - margin_moves[roots]).max() < 5e-5
+    # the middle of a lash's root moves as its point of the margin does (to 0.04 mm: it
+    # sits 0.05 mm off the skin and turns with the lid)
+    root_moves = lash_moves.reshape(-1, RIBS, 3)[:, :2].mean(axis=1)
+    assert np.abs(root_moves - margin_moves[::RIBS]).max() < 4e-5
     # the upper lashes went down with the lid, most near the lid's middle (3.1)
     point = face.feature_points["3.1"]
     drop = rest[point, 1] - moved[point, 1]
