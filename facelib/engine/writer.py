@@ -15,7 +15,7 @@ import numpy as np
 
 from facelib.atomic import atomic_path, write_text_atomic
 from facelib.engine.definition import FORMAT, VERSION
-from facelib.engine.face import PART_NAMES, Face
+from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, Face
 from facelib.errors import FaceModelError
 
 __all__ = ["face_document", "write_face"]
@@ -28,7 +28,7 @@ def _round(values: np.ndarray) -> list[float]:
 def face_document(face: Face, *, mesh: str, name: str, source: str = "") -> dict[str, Any]:
     """The JSON document of a face definition (format ``facelib-face`` version 1)."""
     parts = {}
-    for part in PART_NAMES:
+    for part in (*PART_NAMES, *(p for p in OPTIONAL_PARTS if p in face.parts)):
         ids = face.parts[part].vertex_ids
         if not ids.size or not np.array_equal(ids, np.arange(ids[0], ids[0] + ids.size)):
             raise FaceModelError(f"part {part!r} is not one contiguous vertex range")
@@ -63,7 +63,20 @@ def face_document(face: Face, *, mesh: str, name: str, source: str = "") -> dict
         "pivots": {k: _round(v) for k, v in face.pivots.items()},
         "neck": {"point": _round(point), "normal": _round(normal), "blend": float(blend)},
         "regions": regions,
-    }
+    } | _riders(face)
+
+
+def _riders(face: Face) -> dict[str, Any]:
+    """The ``riders`` entry: per optional part, its vertices' anchor pairs and blends."""
+    out = {}
+    order = {int(v): k for k, v in enumerate(face.riders.vertices)}
+    for part in OPTIONAL_PARTS:
+        if part not in face.parts:
+            continue
+        at = [order[int(v)] for v in face.parts[part].vertex_ids]
+        out[part] = {"anchors": face.riders.anchors[at].tolist(),
+                     "blend": [round(float(t), 6) for t in face.riders.blend[at]]}
+    return {"riders": out} if out else {}
 
 
 def write_face(face: Face, path: str | Path, *, name: str = "", source: str = "") -> Path:

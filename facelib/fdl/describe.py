@@ -54,4 +54,9 @@ def describe(sb: Storyboard) -> str:
             f"  gaze     {_span(g.start_ms, g.duration_ms)}  {g.behaviour}({args})"
             f"{_where(g.origin)}"
         )
+    out.extend(
+        f"  camera   {_span(c.start_ms, c.duration_ms)}  {c.framing}"
+        f"{' (cut)' if c.duration_ms == 0 else ''}{_where(c.origin)}"
+        for c in sb.camera
+    )
     return "\n".join(out)

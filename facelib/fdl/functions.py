@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from facelib.errors import FdlError
-from facelib.fdl import modern
+from facelib.fdl import camera, modern
 from facelib.fdl.context import Context
 from facelib.fdl.thesis import SCRIPT_GLOBALS
 
@@ -67,6 +67,10 @@ FUNCTIONS: Mapping[str, StoryboardFunction] = MappingProxyType({
         StoryboardFunction(
             "look", ("at", "dur"), 'look { "lookTo", "left", 17, "yes", dur = 2 }',
             modern.read_look,
+        ),
+        StoryboardFunction(
+            "camera", ("framing", "at", "dur"),
+            'camera { framing = "head", at = 2, dur = 0.5 }', camera.read_camera,
         ),
         StoryboardFunction(
             "define_expression", None, 'define_expression { "smirk", raise_l_cornerlip = 120 }',

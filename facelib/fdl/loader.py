@@ -23,6 +23,7 @@ from facelib.checks import did_you_mean
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard
 from facelib.errors import FdlError, FdlWarning, ParameterError
 from facelib.fdl import modern_cues, thesis_cues
+from facelib.fdl.camera import camera_cues
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.functions import SETTINGS, function_names, known_globals, read_calls
 from facelib.fdl.modern import ModernParts
@@ -218,6 +219,7 @@ def _build(
         output=output,
         expression_mixes=parts.expression_mixes,
         face=face,
+        camera=camera_cues(parts.camera, ctx),
     )
 
 

@@ -34,6 +34,7 @@ __all__ = [
     "read_look",
     "read_say",
     "read_show",
+    "table_of",
 ]
 
 _SAY_RANGES = {"rate": (0.5, 2.5), "pitch": (0.0, 100.0)}
@@ -80,6 +81,7 @@ class ModernParts:
     expression_defs: dict[str, Mapping[str, float]] = field(default_factory=dict)
     expression_mixes: dict[str, Mapping[str, float]] = field(default_factory=dict)
     gaze_defs: dict[str, Mapping[str, Any]] = field(default_factory=dict)
+    camera: list[DraftCue] = field(default_factory=list)
 
 
 def _table(
@@ -102,6 +104,11 @@ def _table(
                 line=line,
             )
     return arg
+
+
+table_of = _table
+"""``table_of(arg, fn, ctx, line, *, allowed)``: the one table argument of a storyboard
+function, its named fields checked (for readers outside this module)."""
 
 
 def _name(

@@ -18,6 +18,7 @@ from facelib.errors import ParameterError
 from facelib.gaze.behaviours import BoundBehaviour, bind_behaviour, merge_behaviours
 from facelib.gaze.blinks import blink_closure, schedule_blinks
 from facelib.gaze.events import Blink, GazeEvent, HeadMove, Saccade
+from facelib.gaze.fixation import Fixational, fixational_motion, hold_envelope
 from facelib.gaze.model import gaze_model
 from facelib.gaze.motion import Motion
 from facelib.gaze.planner import Planner
@@ -48,13 +49,17 @@ class GazeAnimation:
     track: FapTrack with weight on FAPs 19-26 (lids, eyeballs; always 1) and 48-50 (head;
         1 where the eyes turn the head, fading to 0 within 0.5 deg of neutral).
     saccades, blinks, head_moves: event records in time order (seconds, degrees).
-    gaze: (n_frames, 2) float64 degrees (left, up) of the gaze line (eyes plus head).
-    eyes: (n_frames, 2) float64 degrees, eye-in-head rotation (within the eye limits).
+    gaze: (n_frames, 2) float64 degrees (left, up) of the planned gaze line (eyes plus head,
+        without the fixational motion).
+    eyes: (n_frames, 2) float64 degrees, eye-in-head rotation (within the eye limits),
+        with the fixational drift and micro-saccades of gaze holds.
     head: (n_frames, 2) float64 degrees (left, up), head rotation.
     lid_closure: (n_frames,) float64 in [0, 1], blink closure.
     open_track: the same track with the lids as they would be without blinks; the
         synchronizer blends those with the expressions and applies the blinks after.
     blink_lids: (upper, lower) lid FAP values in IRISD units at full blink closure.
+    microsaccades: onsets (s) of the micro-saccades of the gaze holds (their steps and the
+        drift are in ``eyes``; see :mod:`facelib.gaze.fixation`).
     """
 
     track: FapTrack
@@ -67,6 +72,7 @@ class GazeAnimation:
     lid_closure: np.ndarray
     open_track: FapTrack
     blink_lids: tuple[float, float]
+    microsaccades: tuple[float, ...] = ()
 
     @property
     def events(self) -> tuple[GazeEvent, ...]:
@@ -131,7 +137,7 @@ def animate(
     ]
     default = bind_behaviour("default", (), library=library)
     seconds = n_frames / fps
-    gaze_rng, blink_rng = np.random.default_rng(seed).spawn(2)
+    gaze_rng, blink_rng, fixation_rng = np.random.default_rng(seed).spawn(3)
     planner = Planner(gaze_rng, _mode_lookup(speaking, fps, n_frames))
 
     segments = _segments(bound, default, seconds)
@@ -144,7 +150,11 @@ def animate(
     blinks = schedule_blinks(
         blink_rng, seconds=seconds, rate_per_min=planner.blink_rate, evoked_at=planner.evoked
     )
-    return _render(planner, blinks, fps=fps, n_frames=n_frames, vergence=None)
+    times = np.arange(n_frames, dtype=float) / fps
+    fixation = fixational_motion(fixation_rng, times,
+                                 still=hold_envelope(times, planner.saccades))
+    return _render(planner, blinks, fps=fps, n_frames=n_frames, vergence=None,
+                   fixation=fixation)
 
 
 def _segments(
@@ -191,12 +201,14 @@ def _render(
     fps: float,
     n_frames: int,
     vergence: np.ndarray | None,
+    fixation: Fixational | None = None,
 ) -> GazeAnimation:
     model = gaze_model()
     times = np.arange(n_frames, dtype=float) / fps
     gaze = planner.gaze.sample(times)
     head = planner.head.sample(times)
-    eyes = np.clip(gaze - head, planner.eye_lo, planner.eye_hi)
+    still = 0.0 if fixation is None else fixation.offsets  # fixational drift, micro-saccades
+    eyes = np.clip(gaze - head + still, planner.eye_lo, planner.eye_hi)
     closure = blink_closure(times, blinks, frame_s=1.0 / fps)
     b = model["blink"]
     upper_open, lower_open = _open_lids(planner.lid.sample(times)[:, 0], eyes[:, 1])
@@ -240,6 +252,7 @@ def _render(
         lid_closure=arrays[3],
         open_track=open_track,
         blink_lids=(float(b["upper_closure_irisd"]), float(b["lower_closure_irisd"])),
+        microsaccades=() if fixation is None else tuple(fixation.microsaccades.tolist()),
     )
 
 

@@ -19,6 +19,7 @@ from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS
 from facelib.progress import ProgressCallback, progress_callback
+from facelib.rendering.camera import CameraTrack, camera_of
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import open_writer, save_png
@@ -79,17 +80,21 @@ def face_or_default(face: Deformable | str | os.PathLike[str] | None,
 
 def iter_frames(
     renderer: FaceRenderer, face: Deformable, stream: FapStream, *,
-    progress: bool | ProgressCallback | None = False,
+    progress: bool | ProgressCallback | None = False, camera: CameraTrack | None = None,
 ) -> Iterator[np.ndarray]:
     """Yield one ``(H, W, 3) uint8`` image per frame of ``stream`` deformed by ``face``.
 
     ``progress``: see :mod:`facelib.progress`; called with (frames done, n_frames).
+    ``camera``: a camera per frame (storyboard camera cues), or None to keep the renderer's.
     """
     report = progress_callback(progress, "rendering", unit="frames")
     done = 0
     for start in range(0, stream.n_frames, _CHUNK):
         vertices = np.asarray(face.deform(stream[start : start + _CHUNK]), np.float32)
         for frame_vertices in vertices:
+            if camera is not None:
+                renderer.set_camera(camera.poses[done], znear=camera.znear[done],
+                                    zfar=camera.zfar[done])
             yield renderer.frame(frame_vertices)
             done += 1
             if report is not None:
@@ -131,7 +136,7 @@ def render(
     fps: resample the stream to this frame rate first (None keeps the stream's).
 
     Returns ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the
-    written path. The camera is framed once on the neutral face and stays put.
+    written path. The camera frames the neutral face; storyboard camera cues move it.
     """
     stream, source_audio, source_offset = stream_of(source)
     if fps is not None:
@@ -149,7 +154,8 @@ def render(
             audio = speech_audio_file(source, Path(folder) / "speech.wav")
         with FaceRenderer(face, width=width, height=height, background=background,
                           framing=framing) as renderer:
-            frames = iter_frames(renderer, face, stream, progress=progress)
+            frames = iter_frames(renderer, face, stream, progress=progress, camera=camera_of(
+                source, renderer, face, stream, framing=framing))
             if out is None:
                 return _collect(frames, stream.n_frames, renderer.height, renderer.width)
             mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None

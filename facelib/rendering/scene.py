@@ -527,6 +527,7 @@ class FaceRenderer:
             baseColorFactor=(1.0, 1.0, 1.0, 1.0),
             metallicFactor=float(spec.get("metallic", 0.0)),
             roughnessFactor=float(spec.get("roughness", 0.6)),
+            doubleSided=bool(spec.get("double_sided", False)),
         )
 
     def _build_scene(
@@ -621,6 +622,14 @@ class FaceRenderer:
         except Exception as exc:
             raise RenderError(f"OpenGL rendering failed ({type(exc).__name__}: {exc})") from exc
         return np.ascontiguousarray(downsample(color[:, :, :3], self._scale), dtype=np.uint8)
+
+    def set_camera(self, pose: np.ndarray, *, znear: float, zfar: float) -> None:
+        """Move the camera to ``pose`` ``(4, 4)`` (camera to face coordinates) with these
+        clipping distances (storyboard camera cues; see :mod:`facelib.rendering.camera`)."""
+        node = self.scene.main_camera_node
+        node.camera.znear, node.camera.zfar = float(znear), float(zfar)
+        self.camera_pose = np.asarray(pose, np.float64)
+        self.scene.set_pose(node, self.camera_pose)
 
     def project(self, points: np.ndarray) -> np.ndarray:
         """Pixel coordinates ``(N, 2) float64`` (column, row; origin top-left) of ``(N, 3)``

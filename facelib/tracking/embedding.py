@@ -11,12 +11,15 @@ rendering; :func:`embed_landmarks` recomputes it for any face (needs the ``rende
 from __future__ import annotations
 
 from functools import cache
+from types import SimpleNamespace
+from typing import cast
 
 import numpy as np
 
 from facelib.checks import check_number
 from facelib.data import json_data
 from facelib.data import path as data_path
+from facelib.engine.face import OPTIONAL_PARTS
 from facelib.errors import DataError, TrackingError
 from facelib.mpeg4 import N_FAPS, FapStream
 from facelib.rendering.protocols import Deformable
@@ -46,7 +49,8 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
     values = np.zeros(N_FAPS, np.float32)
     values[2] = check_number("open_jaw", open_jaw, low=0)
     vertices = np.asarray(face.deform(FapStream(25.0, values[None]))[0], np.float64)
-    with FaceRenderer(face, width=width, height=height, framing="head") as renderer:
+    with FaceRenderer(_without_hair(face), width=width, height=height,
+                      framing="head") as renderer:
         image = renderer.frame(vertices)
         projected = renderer.project(vertices)
         camera = np.linalg.inv(renderer.camera_pose)
@@ -55,12 +59,31 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
     if found is None:
         raise TrackingError("MediaPipe finds no face on the rendered neutral mesh")
     depth = -(np.hstack([vertices, np.ones((len(vertices), 1))]) @ camera.T)[:, 2]
+    parts = getattr(face, "parts", {}) or {}
+    hair = [parts[p].vertex_ids for p in OPTIONAL_PARTS if p in parts]
+    projected[np.concatenate([np.zeros(0, np.int64), *hair])] = np.inf  # no landmark there
     out = np.empty(N_LANDMARKS, np.int64)
     for i, point in enumerate(found.points[:, :2]):
         dist = np.linalg.norm(projected - point, axis=1)
         near = np.flatnonzero(dist < radius)
         out[i] = near[np.argmin(depth[near])] if near.size else int(np.argmin(dist))
     return out
+
+
+def _without_hair(face: Deformable) -> Deformable:
+    """``face`` as the renderer sees it, less its optional parts (the lashes): landmarks
+    lie on the skin, and MediaPipe should see it unhidden."""
+    parts = dict(getattr(face, "parts", {}) or {})
+    hair = [parts.pop(p) for p in OPTIONAL_PARTS if p in parts]
+    if not hair:
+        return face
+    drop = np.concatenate([h.vertex_ids for h in hair])
+    triangles = np.asarray(face.triangles)
+    keep = ~np.isin(triangles, drop).any(axis=1)
+    return cast(Deformable, SimpleNamespace(
+        vertices=face.vertices, triangles=triangles[keep],
+        vertex_colors=getattr(face, "vertex_colors", None),
+        parts=parts, feature_points=getattr(face, "feature_points", {}), deform=face.deform))
 
 
 @cache

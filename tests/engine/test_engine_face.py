@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facelib.engine import PART_NAMES, Face
+from facelib.engine import OPTIONAL_PARTS, PART_NAMES, Face
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap, fap_table
@@ -24,7 +24,7 @@ def test_mesh_arrays_and_parts(face: Face) -> None:
     assert t.dtype == np.int32 and t.shape[1] == 3 and t.max() < len(v)
     assert c.shape == v.shape and c.min() >= 0 and c.max() <= 1
     assert not v.flags.writeable
-    assert tuple(face.parts) == PART_NAMES
+    assert tuple(face.parts) == (*PART_NAMES, *OPTIONAL_PARTS)
     covered = sum(len(p.triangles) for p in face.parts.values())
     assert covered == len(t)
     ids = np.concatenate([p.vertex_ids for p in face.parts.values()])

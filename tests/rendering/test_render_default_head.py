@@ -161,3 +161,40 @@ def test_closed_lids_cover_the_cartoons_bigger_eyes(fap_frame):
             white.append(((image.min(2) > 120) & (np.ptp(image, axis=2) < 40)).sum())
     assert white[0] > 1000
     assert white[1] < 0.01 * white[0]
+
+
+def _without_lashes(face):  # type: ignore[no-untyped-def]
+    """The same head with the lash triangles left out (for a before/after render)."""
+    from types import SimpleNamespace
+
+    lashes = set(face.parts["lashes"].vertex_ids.tolist())
+    keep = ~np.isin(face.triangles, list(lashes)).any(axis=1)
+    parts = {k: v for k, v in face.parts.items() if k != "lashes"}
+    return SimpleNamespace(vertices=face.vertices, triangles=face.triangles[keep],
+                           vertex_colors=face.vertex_colors, parts=parts)
+
+
+@pytest.mark.parametrize("closure", [0.0, 1024.0])
+def test_lashes_darken_the_lid_margin(closure, fap_frame):  # type: ignore[no-untyped-def]
+    """Issue 14: in a close-up of the left eye, the band along the upper lid margin is
+    clearly darker with the lashes than without, open and closed; the forehead is not."""
+    face = engine.load_face(None)
+    fp = face.feature_points
+    centre = face.pivots["eye_l"]
+    box = centre + np.array([[-0.02, -0.012, 0.0], [0.02, 0.012, 0.0]])
+    values = fap_frame(close_t_l_eyelid=closure, close_t_r_eyelid=closure)
+    moved = face.deform_frame(values)
+    images = []
+    for shown in (face, _without_lashes(face)):
+        with FaceRenderer(shown, width=320, height=200, framing=box) as renderer:
+            images.append(renderer.frame(moved).astype(float).mean(axis=2))
+            (x, y), = renderer.project(moved[fp["3.1"]])
+            (x_out, _), = renderer.project(moved[fp["3.1"]] + [0.009, 0.0, 0.0])
+    x, y, span = int(x), int(y), int(abs(x_out - x))
+    band = (slice(max(y - 12, 0), y + 12), slice(x - span, x + span))
+    with_lashes, bare = images[0][band], images[1][band]
+    darker = (bare - with_lashes) > 40
+    assert bare.mean() - with_lashes.mean() > 20  # grey levels of 255
+    assert darker.mean() > 0.12  # many dark strands, not a tint
+    assert not darker.all(axis=1).any()  # skin between the strands: not a black band
+    assert np.abs(images[0][:20] - images[1][:20]).max() < 1  # the brow area is untouched
