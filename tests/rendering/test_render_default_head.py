@@ -171,7 +171,8 @@ def _without_lashes(face):  # type: ignore[no-untyped-def]
     keep = ~np.isin(face.triangles, list(lashes)).any(axis=1)
     parts = {k: v for k, v in face.parts.items() if k != "lashes"}
     return SimpleNamespace(vertices=face.vertices, triangles=face.triangles[keep],
-                           vertex_colors=face.vertex_colors, parts=parts)
+                           vertex_colors=face.vertex_colors, parts=parts,
+                           vertex_ao=face.vertex_ao)
 
 
 @pytest.mark.parametrize("closure", [0.0, 1024.0])
