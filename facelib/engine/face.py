@@ -257,18 +257,11 @@ class Face:
             [r.vertices for r in regions] + [np.zeros(0, np.int32)]))
         operator, steps = _compile(verts, tris, points, fapu, regions)
         operator = riders.operator(operator)
-        for region in regions:
-            for eye in ("eye_l", "eye_r"):
-                if np.isin(region.vertices, part_map[eye].vertex_ids).any():
-                    raise FaceModelError(
-                        f"region {region.name!r} contains vertices of {eye}; eyeballs are "
-                        "rigid and move only with FAP 23-28"
-                    )
+        _check_rigid_eyes(regions, part_map)
         columns = np.unique(operator.indices).astype(np.int64)
         dense = operator[:, columns].toarray().astype(np.float32)
         rigid_parts = _rigid(verts, points, fapu, regions=_lids_with_riders(regions, riders),
-                             parts=part_map,
-                             pivots=pivot_map, neck=neck, operator=operator)
+                             parts=part_map, pivots=pivot_map, neck=neck, operator=operator)
         return cls(
             vertices=verts,
             triangles=tris,
@@ -440,6 +433,17 @@ class Face:
         out.reshape(nb, -1)[:] += r.head_tiled
         out.reshape(nb, -1)[:, r.neck] = rigid.rotate_weighted(
             neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
+
+
+def _check_rigid_eyes(regions: tuple[Region, ...], parts: Mapping[str, Part]) -> None:
+    """Refuse a region that reaches into an eyeball (eyeballs move rigidly, FAP 23-28)."""
+    for region in regions:
+        for eye in ("eye_l", "eye_r"):
+            if np.isin(region.vertices, parts[eye].vertex_ids).any():
+                raise FaceModelError(
+                    f"region {region.name!r} contains vertices of {eye}; eyeballs are "
+                    "rigid and move only with FAP 23-28"
+                )
 
 
 def _lids_with_riders(regions: tuple[Region, ...], riders: Riders) -> tuple[Region, ...]:

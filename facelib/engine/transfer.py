@@ -119,13 +119,7 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         colours.append(col)
         occlusion.append(ao)
         offset += len(pos)
-    part_of = np.empty(source.n_vertices, dtype=object)
-    local_of = np.zeros(source.n_vertices, np.int64)
-    for name in names:
-        ids = source.parts[name].vertex_ids
-        part_of[ids] = name
-        local_of[ids] = np.arange(ids.size)
-    mapper = _Mapper(blocks, part_of, local_of, warped, names)
+    mapper = _mapper(source, blocks, warped, names)
     points = mapper.feature_points(source.feature_points, landmark_vertices)
     pivots = _pivots(source, tps, blocks, positions)
     verts = np.concatenate(positions)
@@ -139,6 +133,18 @@ def transfer_face(source: Face, target: HeadMesh, tps: ThinPlateSpline,
         parts=parts, feature_points=points, regions=regions,
         pivots=pivots, neck=_neck(source, tps), riders=_riders(source, mapper),
         vertex_ao=None if source.vertex_ao is None else np.clip(np.concatenate(occlusion), 0, 1))
+
+
+def _mapper(source: Face, blocks: Mapping[str, object], warped: np.ndarray,
+            names: tuple[str, ...]) -> _Mapper:
+    """The :class:`_Mapper` of the source parts ``names`` onto their output blocks."""
+    part_of = np.empty(source.n_vertices, dtype=object)
+    local_of = np.zeros(source.n_vertices, np.int64)
+    for name in names:
+        ids = source.parts[name].vertex_ids
+        part_of[ids] = name
+        local_of[ids] = np.arange(ids.size)
+    return _Mapper(blocks, part_of, local_of, warped, names)
 
 
 def _riders(source: Face, mapper: _Mapper) -> Riders:

@@ -83,6 +83,7 @@ def _without_hair(face: Deformable) -> Deformable:
     return cast(Deformable, SimpleNamespace(
         vertices=face.vertices, triangles=triangles[keep],
         vertex_colors=getattr(face, "vertex_colors", None),
+        vertex_ao=getattr(face, "vertex_ao", None),
         parts=parts, feature_points=getattr(face, "feature_points", {}), deform=face.deform))
 
 
