@@ -33,15 +33,21 @@ from facelib.checks import check_fps
 from facelib.data import json_data
 from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
-from facelib.tracking.layouts import LandmarkLayout, landmark_layout
-from facelib.tracking.pose import (
-    HeadPose,
-    euler_angles,
-    fit_pose,
-    refine_pose_2d,
-    unpose,
-    unpose_2d,
+from facelib.tracking.headframe import (
+    HeadFrame,
+    face_frame,
+    fill_gaps,
+    frame_spans,
+    head_frame,
+    neutral_span,
 )
+from facelib.tracking.layouts import LandmarkLayout, landmark_layout
+from facelib.tracking.observation import (
+    ObservationModel,
+    default_observation,
+    solve_observation,
+)
+from facelib.tracking.pose import HeadPose, euler_angles
 from facelib.tracking.relations import apply_relations
 from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
@@ -77,72 +83,6 @@ class TrackedFaps:
 @cache
 def _model() -> dict[str, dict[str, float]]:
     return json_data("tracking/model.json")
-
-
-def face_frame(landmarks: np.ndarray) -> np.ndarray:
-    """Image coordinates (column, row[, depth toward the scene]) -> the face frame (``x``
-    right in the image = the face's left, ``y`` up, ``z`` toward the camera). Same shape."""
-    out = np.array(landmarks, np.float64)
-    out[..., 1:] *= -1.0
-    return out
-
-
-def frame_spans(frames: np.ndarray) -> str:
-    """Frame indices (sorted) as text: ``"3-7, 12"``."""
-    parts, start = [], None
-    for i, f in enumerate(frames):
-        if start is None:
-            start = f
-        if i + 1 == len(frames) or frames[i + 1] != f + 1:
-            parts.append(f"{start}" if start == f else f"{start}-{f}")
-            start = None
-    return ", ".join(parts)
-
-
-def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
-    """Interpolate frames whose landmarks hold NaN (no face) linearly in time.
-
-    ``(n, K, D)`` -> (filled copy, the filled frame indices). Frames before the first or
-    after the last face hold the nearest face. TrackingError if no frame has a face.
-    """
-    data = np.array(landmarks, np.float64)
-    lost = ~np.isfinite(data).reshape(len(data), -1).all(axis=1)
-    if not lost.any():
-        return data, ()
-    good = np.flatnonzero(~lost)
-    if not good.size:
-        raise TrackingError(f"no face in any of the {len(data)} frames")
-    flat = data.reshape(len(data), -1)
-    idx = np.arange(len(data))
-    for col in range(flat.shape[1]):
-        flat[lost, col] = np.interp(idx[lost], good, flat[good, col])
-    return data, tuple(int(i) for i in np.flatnonzero(lost))
-
-
-def _neutral_span(neutral: int | tuple[int, int], n: int) -> slice:
-    start, stop = (neutral, neutral + 1) if isinstance(neutral, int) else neutral
-    if not 0 <= start < stop <= n:
-        raise ParameterError(f"neutral frames {neutral!r} are outside the {n} frames")
-    return slice(start, stop)
-
-
-def _remove_pose(points: np.ndarray, layout: LandmarkLayout, span: slice,
-                 rest_all: np.ndarray) -> tuple[np.ndarray, HeadPose | None]:
-    """All landmarks ``(n, K, D)`` in the neutral head's frame, and the fit."""
-    dim = points.shape[2]
-    if len(layout.stable) > dim:
-        stable = points[:, layout.stable]
-        rest = rest_all[layout.stable]
-        pose = fit_pose(rest, stable)
-        if dim == 2:
-            return unpose(points, pose), pose
-        pose = refine_pose_2d(rest, stable, pose)
-        return unpose_2d(points, rest_all, pose), pose
-    if "9.3" not in layout.feature_points:
-        raise TrackingError("without stable points the nose tip 9.3 must be tracked "
-                            "(the seed's reference point)")
-    nose = layout.feature_point_positions(points)[:, layout.index("9.3")]
-    return points - (nose - nose[span].mean(axis=0))[:, None, :], None
 
 
 def _plan(layout: LandmarkLayout, pose: HeadPose | None
@@ -227,20 +167,40 @@ def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     return out
 
 
+Model = RigModel | ObservationModel
+"""What :func:`measure_faps` fits to the landmark motion."""
+
+
 def _inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
-            rig: RigModel | Literal["auto", "default"] | None
-            ) -> tuple[np.ndarray, LandmarkLayout, RigModel | None]:
-    """Checked ``(n, K, D)`` landmarks, the layout, and the rig model to fit (or None)."""
+            rig: Model | Literal["auto", "default", "observed"] | None
+            ) -> tuple[np.ndarray, LandmarkLayout, Model | None]:
+    """Checked ``(n, K, D)`` landmarks, the layout, and the model to fit (or None)."""
     data = np.asarray(landmarks, np.float64)
     if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
         raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
     if isinstance(layout, str):
         layout = landmark_layout(layout, data.shape[1])
+    mediapipe_3d = layout.name == "mediapipe" and data.shape[2] == 3
     if rig == "auto":
-        rig = "default" if layout.name == "mediapipe" and data.shape[2] == 3 else None
+        rig = "observed" if mediapipe_3d and layout.n_points == 478 else None
     if rig == "default" and layout.name != "mediapipe":
         raise ParameterError(f"rig='default' needs MediaPipe landmarks, not {layout.name!r}")
-    return data, layout, default_rig() if rig == "default" else rig
+    if (rig == "observed" or isinstance(rig, ObservationModel)) and not (
+            mediapipe_3d and layout.n_points == 478):
+        raise ParameterError("the observation model needs MediaPipe's 478 landmarks in 3-D")
+    if rig == "default":
+        return data, layout, default_rig()
+    if rig == "observed":
+        return data, layout, default_observation()
+    return data, layout, rig
+
+
+def _observe(frame: HeadFrame, model: ObservationModel, *, values: np.ndarray,
+             mask: np.ndarray) -> None:
+    """FAPs of ``model`` from the landmark motion (:mod:`~facelib.tracking.observation`)."""
+    found = solve_observation(model, (frame.landmarks - frame.rest)[..., :2], frame.fapu)
+    values[:, model.faps - 1] = found
+    mask[:, model.faps - 1] = True
 
 
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
@@ -267,7 +227,7 @@ def measure_faps(
     smooth: bool = True,
     states: Mapping[str, np.ndarray] | None = None,
     relations: bool = True,
-    rig: RigModel | Literal["auto", "default"] | None = "auto",
+    rig: Model | Literal["auto", "default", "observed"] | None = "auto",
 ) -> TrackedFaps:
     """FAPs from landmark tracks; see the module docstring for the steps.
 
@@ -295,20 +255,21 @@ def measure_faps(
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
-    points = face_frame(data)
-    span = _neutral_span(neutral, len(data))
-    local_all, pose = _remove_pose(points, layout, span, points[span].mean(axis=0))
-    local = layout.feature_point_positions(local_all)
-    rest = local[span].mean(axis=0)
-    units = user_fapu(dict(zip(layout.feature_points, rest, strict=True)), fapu)
+    span = neutral_span(neutral, len(data))
+    frame = head_frame(data, layout=layout, span=span, fapu=fapu)
+    local_all, local, rest, units, pose = (frame.landmarks, frame.points, frame.rest_points,
+                                           frame.fapu, frame.pose)
     values = np.zeros((len(data), N_FAPS))
     mask = np.zeros((len(data), N_FAPS), bool)
-    for col, row, axis, sign, unit in _plan(layout, pose):  # eq. 4.16, per axis
-        values[:, col] = sign * (local - rest)[:, row, axis] / units[unit]
-        mask[:, col] = True
-    if model is not None:
-        _fit(local_all, span, units, model, values=values, mask=mask)
-    _gaze(local, layout, span, values, mask)
+    if model is None or isinstance(model, RigModel):
+        for col, row, axis, sign, unit in _plan(layout, pose):  # eq. 4.16, per axis
+            values[:, col] = sign * (local - rest)[:, row, axis] / units[unit]
+            mask[:, col] = True
+        if model is not None:
+            _fit(local_all, span, units, model, values=values, mask=mask)
+        _gaze(local, layout, span, values, mask)
+    else:
+        _observe(frame, model, values=values, mask=mask)
     if pose is not None:
         for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
             values[:, fap_id - 1] = angle / ANGLE_UNIT

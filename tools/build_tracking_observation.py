@@ -1,0 +1,144 @@
+"""Learn how MediaPipe's landmarks move with each FAP on the default head (analysis by synthesis).
+
+Usage (from the repository root; needs the ``render`` and ``track`` extras)::
+
+    OMP_NUM_THREADS=1 python tools/build_tracking_observation.py [--frames 1200] [--seed 7]
+
+1. A training stream is drawn at random (seeded): every 3 frames a new face pose (a random
+   viseme and expression of facelib's own libraries at random weights, plus independent
+   random pushes of every modelled FAP, lids, blinks and gaze), every 12 frames a new head
+   pose (yaw up to 25 degrees, pitch 12, roll 10), linearly interpolated between, after 8
+   neutral frames. It shares nothing with ``examples/hello/hello.fdl``, the closed-loop
+   test stream.
+2. The default head is rendered with it at 640x480 (framed as a webcam sees a head) and
+   tracked with MediaPipe in video mode; landmarks and truth are cached in
+   ``out/tracking_observation_training.npz`` (re-used unless ``--fresh``).
+3. :func:`facelib.tracking.observation.learn_observation` fits the observation model and
+   it is written to ``facelib/data/tracking/observation_mediapipe.npz``.
+
+Deterministic up to MediaPipe's and the renderer's own floating point.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from facelib.data import path as data_path
+from facelib.engine import default_face
+from facelib.expressions import default_library
+from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream, fap, fap_table
+from facelib.tracking.closedloop import with_neutral_lead
+from facelib.tracking.observation import MODEL_FAPS, learn_observation, save_observation
+
+ROOT = Path(__file__).resolve().parent.parent
+CACHE = ROOT / "out" / "tracking_observation_training.npz"
+OUT = ROOT / "facelib" / "data" / "tracking" / "observation_mediapipe.npz"
+FPS = 25.0
+NEUTRAL = 8
+FACE_STEP, HEAD_STEP = 3, 12
+EXTRA_FAPS = (18, 44, 45, 46, 63, 81, 82)
+"""Driven in training as nuisance (chin, tongue, nose), not modelled."""
+
+
+def vocabulary() -> tuple[np.ndarray, list[np.ndarray]]:
+    """Largest magnitude per FAP over facelib's expressions and visemes ``(84,)``, and the
+    poses (expressions and visemes at full intensity, ``(84,)`` each)."""
+    poses = [np.asarray(e.values, np.float64) for e in default_library().expressions.values()]
+    visemes = json.loads(data_path("visemes/viseme_faps.json").read_text())["visemes"]
+    for viseme in visemes.values():
+        values = np.zeros(N_FAPS)
+        for name, value in viseme["faps"].items():
+            values[fap(name).index] = value
+        poses.append(values)
+    return np.max(np.abs(poses), axis=0), poses
+
+
+def face_pose(rng: np.random.Generator, reach: np.ndarray, poses: list[np.ndarray]) -> np.ndarray:
+    """One random face pose ``(84,)`` in FAP units."""
+    values = poses[rng.integers(len(poses))] * rng.uniform(0, 1.2)
+    values = values + poses[rng.integers(len(poses))] * rng.uniform(0, 0.6) * (rng.random() < 0.5)
+    for fap_id in (*MODEL_FAPS, *EXTRA_FAPS):
+        if rng.random() < 0.3 and fap_id not in range(19, 27):
+            low = 0.0 if fap_table()[fap_id - 1].min == 0 else -1.0
+            values[fap_id - 1] += rng.uniform(low, 1.0) * max(reach[fap_id - 1], 60.0)
+    blink = rng.random() < 0.15
+    for lid in (19, 20):
+        values[lid - 1] = rng.uniform(700, 1024) if blink else rng.uniform(-200, 500)
+    for lid in (21, 22):
+        values[lid - 1] = rng.uniform(-200, 300)
+    yaw, pitch = np.radians(rng.uniform(-28, 28)), np.radians(rng.uniform(-18, 18))
+    for eye in (0, 1):
+        values[22 + eye] = (yaw + np.radians(rng.uniform(-4, 4))) / ANGLE_UNIT
+        values[24 + eye] = (pitch + np.radians(rng.uniform(-3, 3))) / ANGLE_UNIT
+    return values
+
+
+def training_stream(frames: int, seed: int) -> FapStream:
+    """The random training stream (``frames`` frames after the neutral lead)."""
+    rng = np.random.default_rng(seed)
+    reach, poses = vocabulary()
+    face_keys = np.stack([face_pose(rng, reach, poses)
+                          for _ in range(frames // FACE_STEP + 2)])
+    head_keys = np.radians(rng.uniform([-12, -25, -10], [12, 25, 10],
+                                       (frames // HEAD_STEP + 2, 3))) / ANGLE_UNIT
+    t = np.arange(frames, dtype=np.float64)
+    values = np.zeros((frames, N_FAPS))
+    for col in range(N_FAPS):
+        values[:, col] = np.interp(t, np.arange(len(face_keys)) * FACE_STEP, face_keys[:, col])
+    for k, col in enumerate((47, 48, 49)):
+        values[:, col] = np.interp(t, np.arange(len(head_keys)) * HEAD_STEP, head_keys[:, k])
+    low = np.array([-np.inf if f.min is None else f.min for f in fap_table()], np.float64)
+    high = np.array([np.inf if f.max is None else f.max for f in fap_table()], np.float64)
+    values = np.clip(values, low, high)
+    return with_neutral_lead(FapStream(FPS, values.astype(np.float32)), NEUTRAL)
+
+
+def render_and_track(stream: FapStream) -> np.ndarray:
+    """``(n, 478, 3)`` MediaPipe landmarks of the default head rendered with ``stream``."""
+    from facelib.rendering import FaceRenderer, iter_frames
+    from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+
+    face = default_face()
+    points = np.full((stream.n_frames, N_LANDMARKS, 3), np.nan)
+    with FaceRenderer(face, width=640, height=480, framing="head") as renderer, \
+            FaceMeshTracker(video=True, max_faces=1) as tracker:
+        for i, image in enumerate(iter_frames(renderer, face, stream)):
+            found = tracker.detect(image)
+            if found is not None:
+                points[i] = found.points
+            if i % 200 == 0:
+                print(f"  frame {i} of {stream.n_frames}", flush=True)
+    return points
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=1200)
+    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--fresh", action="store_true", help="render again, ignore the cache")
+    args = parser.parse_args()
+    stream = training_stream(args.frames, args.seed)
+    if CACHE.exists() and not args.fresh:
+        with np.load(CACHE) as cached:
+            landmarks, values = cached["landmarks"], cached["values"]
+        if not np.array_equal(values, stream.values):
+            raise SystemExit(f"{CACHE} was made with other options; pass --fresh")
+    else:
+        landmarks = render_and_track(stream)
+        values = stream.values
+        CACHE.parent.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(CACHE, landmarks=landmarks.astype(np.float32), values=values)
+    lost = ~np.isfinite(landmarks).all(axis=(1, 2))
+    print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
+    model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL))
+    save_observation(model, OUT)
+    print(f"wrote {OUT.relative_to(ROOT)}: {len(model.faps)} FAPs, "
+          f"{model.estimator.shape[0]} landmarks")
+
+
+if __name__ == "__main__":
+    main()
