@@ -16,6 +16,7 @@ import numpy as np
 
 from facelib.checks import check_count
 from facelib.engine import Face, default_face
+from facelib.errors import ParameterError
 from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
@@ -38,12 +39,24 @@ class ClosedLoop:
     tracked: what tracking recovered (same frame count).
     landmarks: ``(n, 478, 3)`` MediaPipe landmarks of the render.
     frames: ``(n, H, W, 3) uint8`` the rendered frames (None unless ``keep_frames``).
+    lead: ``(k, 478, 3)`` landmarks of the neutral lead frames (cut from ``landmarks``).
     """
 
     truth: FapStream
     tracked: TrackedFaps
     landmarks: np.ndarray
     frames: np.ndarray | None
+    lead: np.ndarray | None = None
+
+    def remeasure(self, **options: Any) -> TrackedFaps:
+        """The same landmarks measured again with other ``options`` of
+        :func:`~facelib.tracking.faps.measure_faps` (e.g. ``rig="default"``), lead cut."""
+        if self.lead is None or not len(self.lead):
+            raise ParameterError("this closed loop kept no neutral lead frames")
+        k = len(self.lead)
+        found = measure_faps(np.concatenate([self.lead, self.landmarks]), fps=self.truth.fps,
+                             neutral=(0, k), **options)
+        return _trim(found, k)
 
     def correlation(self, fap_id: int) -> float:
         """Pearson correlation of the true and recovered curves of FAP ``fap_id`` (NaN if
@@ -108,11 +121,16 @@ def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: 
     tracked = measure_faps(points, fps=stream.fps, neutral=(0, max(neutral_frames, 1)),
                            **options)
     cut = slice(neutral_frames, None)
-    trimmed = TrackedFaps(tracked.stream[cut], tracked.fapu, tracked.pose,
-                          tuple(f - neutral_frames for f in tracked.filled_frames
-                                if f >= neutral_frames))
-    return ClosedLoop(FapStream(stream.fps, stream.values, stream.mask), trimmed, points[cut],
-                      np.stack(rendered)[cut] if keep_frames else None)
+    return ClosedLoop(FapStream(stream.fps, stream.values, stream.mask),
+                      _trim(tracked, neutral_frames), points[cut],
+                      np.stack(rendered)[cut] if keep_frames else None,
+                      points[:neutral_frames])
+
+
+def _trim(tracked: TrackedFaps, lead: int) -> TrackedFaps:
+    """``tracked`` without its first ``lead`` frames."""
+    return TrackedFaps(tracked.stream[lead:], tracked.fapu, tracked.pose,
+                       tuple(f - lead for f in tracked.filled_frames if f >= lead))
 
 
 def closure_events(signal: np.ndarray, threshold: float) -> list[tuple[int, int]]:
