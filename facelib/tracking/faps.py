@@ -13,6 +13,9 @@ The chain, each step a function over arrays:
 4. per-axis displacements of each tracked feature point from its neutral position divided by
    the FAP's unit, signed by the FAP table's direction (eq. 4.16 read per axis, not as the
    printed scalar distance); eyelids 19-22 are the lid points' vertical motion in IRISD;
+   optionally refined by fitting a face's rig (:mod:`~facelib.tracking.rigfit`);
+   for MediaPipe's 478 landmarks in 3-D, by default, the learned observation model
+   (:mod:`~facelib.tracking.observation`) replaces this step and the next one's gaze;
 5. gaze 23-26 from the pupils' motion relative to the eye corners (eyeball radius from the
    eye width), head pitch/yaw/roll 48-50 from the fit;
 6. One Euro smoothing (blinks and closures keep their depth), then the FAP relationships of
@@ -203,6 +206,26 @@ def _observe(frame: HeadFrame, model: ObservationModel, *, values: np.ndarray,
     mask[:, model.faps - 1] = True
 
 
+def _face_faps(frame: HeadFrame, layout: LandmarkLayout, span: slice, model: Model | None
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """``(n, 84)`` values and mask of the face FAPs: the learned model, or eq. 4.16 (refined
+    by a rig fit) and the gaze of the pupils."""
+    n = len(frame.landmarks)
+    values = np.zeros((n, N_FAPS))
+    mask = np.zeros((n, N_FAPS), bool)
+    if isinstance(model, ObservationModel):
+        _observe(frame, model, values=values, mask=mask)
+        return values, mask
+    moved = frame.points - frame.rest_points
+    for col, row, axis, sign, unit in _plan(layout, frame.pose):  # eq. 4.16, per axis
+        values[:, col] = sign * moved[:, row, axis] / frame.fapu[unit]
+        mask[:, col] = True
+    if model is not None:
+        _fit(frame.landmarks, span, frame.fapu, model, values=values, mask=mask)
+    _gaze(frame.points, layout, span, values, mask)
+    return values, mask
+
+
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
             states: Mapping[str, np.ndarray] | None,
             relations: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -243,11 +266,14 @@ def measure_faps(
     smooth: apply the One Euro filter.
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
     relations: fill untracked FAPs by eq. 4.17.
-    rig: fit this face's rig to the landmark motion (:mod:`~facelib.tracking.rigfit`) for
-        the FAPs it models, instead of eq. 4.16's one point per FAP; ``"default"`` is the
-        default head with MediaPipe landmarks (needs the ``mediapipe`` layout); ``"auto"``
-        (the default) uses it for 3-D MediaPipe landmarks and eq. 4.16 otherwise; None
-        always uses eq. 4.16.
+    rig: the model read off the landmark motion instead of eq. 4.16's one point per FAP:
+        ``"observed"`` (or an :class:`~facelib.tracking.observation.ObservationModel`) the
+        observation model learned from renders (needs MediaPipe's 478 landmarks in 3-D;
+        it also gives gaze); ``"default"`` (or a
+        :class:`~facelib.tracking.rigfit.RigModel`) the default head's rig fitted to the
+        landmarks (needs the ``mediapipe`` layout); ``"auto"`` (the default) is
+        ``"observed"`` for 478 3-D MediaPipe landmarks and eq. 4.16 otherwise; None always
+        uses eq. 4.16.
     """
     rate = check_fps(fps)
     data, layout, model = _inputs(landmarks, layout, rig)
@@ -257,26 +283,15 @@ def measure_faps(
                                       f"{len(data)}; interpolated"), stacklevel=2)
     span = neutral_span(neutral, len(data))
     frame = head_frame(data, layout=layout, span=span, fapu=fapu)
-    local_all, local, rest, units, pose = (frame.landmarks, frame.points, frame.rest_points,
-                                           frame.fapu, frame.pose)
-    values = np.zeros((len(data), N_FAPS))
-    mask = np.zeros((len(data), N_FAPS), bool)
-    if model is None or isinstance(model, RigModel):
-        for col, row, axis, sign, unit in _plan(layout, pose):  # eq. 4.16, per axis
-            values[:, col] = sign * (local - rest)[:, row, axis] / units[unit]
-            mask[:, col] = True
-        if model is not None:
-            _fit(local_all, span, units, model, values=values, mask=mask)
-        _gaze(local, layout, span, values, mask)
-    else:
-        _observe(frame, model, values=values, mask=mask)
+    values, mask = _face_faps(frame, layout, span, model)
+    pose = frame.pose
     if pose is not None:
         for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
             values[:, fap_id - 1] = angle / ANGLE_UNIT
             mask[:, fap_id - 1] = True
     values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
                            relations=relations)
-    return TrackedFaps(FapStream(rate, values, mask), units, pose, filled)
+    return TrackedFaps(FapStream(rate, values, mask), frame.fapu, pose, filled)
 
 
 def landmarks_to_faps(landmarks: np.ndarray, *, fps: float, **options: object) -> FapStream:
