@@ -8,11 +8,15 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
    viseme and expression of facelib's own libraries at random weights, plus independent
    random pushes of every modelled FAP, lids, blinks and gaze), every 12 frames a new head
    pose (yaw up to 25 degrees, pitch 12, roll 10), linearly interpolated between, after 8
-   neutral frames. It shares nothing with ``examples/hello/hello.fdl``, the closed-loop
-   test stream.
-2. The default head is rendered with it at 640x480 (framed as a webcam sees a head) and
+   neutral frames. With ``--speech`` a second, speech-like stream follows: storyboards made
+   up here (the sentences below, random expressions and eye behaviours) animated by
+   facelib, with slow random head sweeps (tried, not used for the packaged model: see
+   ``docs/performance-driven.md``). Neither shares anything with
+   ``examples/hello/hello.fdl``, the closed-loop test stream.
+2. The default head is rendered with them at 640x480 (framed as a webcam sees a head) and
    tracked with MediaPipe in video mode; landmarks and truth are cached in
-   ``out/tracking_observation_training.npz`` (re-used unless ``--fresh``).
+   ``out/tracking_observation_training.npz`` and ``out/tracking_observation_speech.npz``
+   (re-used unless ``--fresh``).
 3. :func:`facelib.tracking.observation.learn_observation` fits the observation model and
    it is written to ``facelib/data/tracking/observation_mediapipe.npz``.
 
@@ -36,6 +40,22 @@ from facelib.tracking.observation import MODEL_FAPS, learn_observation, save_obs
 
 ROOT = Path(__file__).resolve().parent.parent
 CACHE = ROOT / "out" / "tracking_observation_training.npz"
+SPEECH_CACHE = ROOT / "out" / "tracking_observation_speech.npz"
+SENTENCES = (
+    "Peter brought a big basket of apples to the market every morning.",
+    "Maybe the blue boat will come back before the moon is up.",
+    "We met a baby bear by the pond, and it ran off into the woods.",
+    "My brother plays the trumpet, but the neighbours prefer his piano.",
+    "Bring me the map, please, and we will find the bridge by noon.",
+    "The old mill by the river made bread for the whole village.",
+    "Nobody expected the spring to be so warm, so bright, so brief.",
+    "Paul bought a pair of boots and a warm woollen cap for the trip.",
+    "A bubble of laughter broke the silence in the empty room.",
+    "Move the lamp a bit to the left, and the picture will be perfect.",
+    "Umbrellas, mittens and maps were piled by the back door.",
+    "Why would anybody paint a purple moth on a marble wall?",
+)
+"""Training speech (made up here; none of it is in ``examples``)."""
 OUT = ROOT / "facelib" / "data" / "tracking" / "observation_mediapipe.npz"
 FPS = 25.0
 NEUTRAL = 8
@@ -97,6 +117,37 @@ def training_stream(frames: int, seed: int) -> FapStream:
     return with_neutral_lead(FapStream(FPS, values.astype(np.float32)), NEUTRAL)
 
 
+def speech_stream(seed: int) -> FapStream:
+    """The speech-like training stream: every sentence of SENTENCES as a storyboard with two
+    random expressions and eye behaviours, concatenated, with slow random head sweeps, after
+    8 neutral frames."""
+    import tempfile
+
+    import facelib
+
+    rng = np.random.default_rng(seed + 1000)
+    names = [n for n in default_library().names if n != "tongueout"]
+    clips = []
+    with tempfile.TemporaryDirectory() as scratch:
+        for i, sentence in enumerate(SENTENCES):
+            cues = [f'say {{ "{sentence}", at = 0.2 }}']
+            cues.extend(f'show {{ "{names[rng.integers(len(names))]}", at = {start}, '
+                        f'dur = {rng.uniform(1.0, 1.8):.2f}, '
+                        f'intensity = {rng.uniform(0.3, 1.0):.2f} }}' for start in (0.0, 1.6))
+            cues.append('look { "default", "talking", 0.9, at = 0, dur = 4 }')
+            story = Path(scratch) / f"clip{i}.fdl"
+            story.write_text(f"fps = {FPS:g}\nseed = {seed + i}\n" + "\n".join(cues) + "\n")
+            clips.append(facelib.run_fdl(story).faps)
+    values = np.array(FapStream.concat(clips).values, np.float64)
+    t = np.arange(len(values)) / FPS
+    for col, (low, high) in ((47, (3, 12)), (48, (5, 25)), (49, (3, 10))):
+        for _ in range(2):
+            amplitude = np.radians(rng.uniform(low, high)) / 2 / ANGLE_UNIT
+            values[:, col] += amplitude * np.sin(2 * np.pi * t / rng.uniform(2.5, 7.0)
+                                                 + rng.uniform(0, 2 * np.pi))
+    return with_neutral_lead(FapStream(FPS, values.astype(np.float32)), NEUTRAL)
+
+
 def render_and_track(stream: FapStream) -> np.ndarray:
     """``(n, 478, 3)`` MediaPipe landmarks of the default head rendered with ``stream``."""
     from facelib.rendering import FaceRenderer, iter_frames
@@ -115,23 +166,33 @@ def render_and_track(stream: FapStream) -> np.ndarray:
     return points
 
 
+def cached_track(stream: FapStream, cache: Path, fresh: bool) -> np.ndarray:
+    """Landmarks of ``stream`` rendered and tracked, from ``cache`` when it holds them."""
+    if cache.exists() and not fresh:
+        with np.load(cache) as cached:
+            if np.array_equal(cached["values"], stream.values):
+                return np.asarray(cached["landmarks"], np.float64)
+        raise SystemExit(f"{cache} was made with other options; pass --fresh")
+    landmarks = render_and_track(stream)
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(cache, landmarks=landmarks.astype(np.float32), values=stream.values)
+    return landmarks
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=1200)
+    parser.add_argument("--frames", type=int, default=3000)
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--speech", action="store_true",
+                        help="add the speech-like stream (tried: better lower lids and outer "
+                             "lip corners, worse open_jaw and lip closures; not packaged)")
     parser.add_argument("--fresh", action="store_true", help="render again, ignore the cache")
     args = parser.parse_args()
-    stream = training_stream(args.frames, args.seed)
-    if CACHE.exists() and not args.fresh:
-        with np.load(CACHE) as cached:
-            landmarks, values = cached["landmarks"], cached["values"]
-        if not np.array_equal(values, stream.values):
-            raise SystemExit(f"{CACHE} was made with other options; pass --fresh")
-    else:
-        landmarks = render_and_track(stream)
-        values = stream.values
-        CACHE.parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(CACHE, landmarks=landmarks.astype(np.float32), values=values)
+    streams = [(training_stream(args.frames, args.seed), CACHE)]
+    if args.speech:
+        streams.append((speech_stream(args.seed), SPEECH_CACHE))
+    landmarks = np.concatenate([cached_track(s, c, args.fresh) for s, c in streams])
+    values = np.concatenate([s.values for s, _ in streams])
     lost = ~np.isfinite(landmarks).all(axis=(1, 2))
     print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL))
