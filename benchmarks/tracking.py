@@ -11,7 +11,8 @@ the correlation and gain of the recovered against the true curve, blink and lip-
 recall, for the learned observation model (the default, ``rig="observed"``) and, from the
 same landmarks, the default head's rig fit (``rig="default"``, the earlier method); then the
 same without the added head turns; then both on the SOMA-X head of ``examples/heads`` (set
-up with ``facelib.setup_face``), which neither model has seen.
+up with ``facelib.setup_face``), which neither model has seen; last the stylised cartoon
+head with head turns.
 """
 
 from __future__ import annotations
@@ -104,6 +105,9 @@ def main() -> None:
                               landmarks="examples/heads/soma_landmarks.json")
     report("SOMA-X head, hello.fdl with head turns", with_head_turns(hello), soma)
     report("SOMA-X head, hello.fdl as scripted", hello, soma)
+    cartoon = facelib.setup_face("examples/heads/cartoon_head.obj",
+                                 landmarks="examples/heads/cartoon_landmarks.json")
+    report("cartoon head, hello.fdl with head turns", with_head_turns(hello), cartoon)
 
 
 if __name__ == "__main__":
