@@ -18,7 +18,9 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
    ``out/tracking_observation_training.npz`` and ``out/tracking_observation_speech.npz``
    (re-used unless ``--fresh``).
 3. :func:`facelib.tracking.observation.learn_observation` fits the observation model and
-   it is written to ``facelib/data/tracking/observation_mediapipe.npz``.
+   it is written to ``facelib/data/tracking/observation_mediapipe.npz``; the closed-lips
+   threshold of :mod:`facelib.tracking.lipclosure` is learned from the random stream's
+   frames and written into ``facelib/data/tracking/lip_closure.json``.
 
 Deterministic up to MediaPipe's and the renderer's own floating point.
 """
@@ -35,7 +37,10 @@ from facelib.data import path as data_path
 from facelib.engine import default_face
 from facelib.expressions import default_library
 from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream, fap, fap_table
-from facelib.tracking.closedloop import with_neutral_lead
+from facelib.tracking.closedloop import lip_gap, with_neutral_lead
+from facelib.tracking.headframe import fill_gaps, head_frame
+from facelib.tracking.layouts import landmark_layout
+from facelib.tracking.lipclosure import inner_lip_aperture, learn_threshold, lip_closure
 from facelib.tracking.observation import MODEL_FAPS, learn_observation, save_observation
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -57,6 +62,7 @@ SENTENCES = (
 )
 """Training speech (made up here; none of it is in ``examples``)."""
 OUT = ROOT / "facelib" / "data" / "tracking" / "observation_mediapipe.npz"
+CLOSURE = ROOT / "facelib" / "data" / "tracking" / "lip_closure.json"
 FPS = 25.0
 NEUTRAL = 8
 FACE_STEP, HEAD_STEP = 3, 12
@@ -179,6 +185,26 @@ def cached_track(stream: FapStream, cache: Path, fresh: bool) -> np.ndarray:
     return landmarks
 
 
+def write_closure_threshold(landmarks: np.ndarray, values: np.ndarray) -> None:
+    """Learn the closed-lips threshold of :mod:`facelib.tracking.lipclosure` from the
+    training frames (default head; open = true inner-lip gap at least 0.1 MNS0) and write
+    it into ``lip_closure.json``."""
+    rule = lip_closure()
+    frame = head_frame(landmarks, layout=landmark_layout("mediapipe"), span=slice(0, NEUTRAL))
+    aperture = inner_lip_aperture(frame, rule)[NEUTRAL:]
+    gap = lip_gap(default_face(), FapStream(FPS, values.astype(np.float32)))[NEUTRAL:]
+    threshold = round(learn_threshold(aperture, gap >= 0.1), 4)
+    raw = json.loads(CLOSURE.read_text())
+    n_open = int((gap >= 0.1).sum())
+    source = (f"learned by tools/build_tracking_observation.py: 15 % of the {n_open} "
+              f"training frames whose inner lips are apart (gap >= 0.1 MNS0 on the default "
+              f"head) have a smaller aperture; no hysteresis (open_above = close_below)")
+    for key in ("close_below", "open_above"):
+        raw[key] = {"value": threshold, "source": source}
+    CLOSURE.write_text(json.dumps(raw, indent=2) + "\n")
+    print(f"wrote {CLOSURE.relative_to(ROOT)}: closed below an aperture of {threshold} MNS0")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=3000)
@@ -191,11 +217,13 @@ def main() -> None:
     streams = [(training_stream(args.frames, args.seed), CACHE)]
     if args.speech:
         streams.append((speech_stream(args.seed), SPEECH_CACHE))
-    landmarks = np.concatenate([cached_track(s, c, args.fresh) for s, c in streams])
+    tracks = [cached_track(s, c, args.fresh) for s, c in streams]
+    landmarks = np.concatenate(tracks)
     values = np.concatenate([s.values for s, _ in streams])
     lost = ~np.isfinite(landmarks).all(axis=(1, 2))
     print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL))
+    write_closure_threshold(fill_gaps(tracks[0])[0], np.asarray(streams[0][0].values))
     save_observation(model, OUT)
     print(f"wrote {OUT.relative_to(ROOT)}: {len(model.faps)} FAPs, "
           f"{model.estimator.shape[0]} landmarks")

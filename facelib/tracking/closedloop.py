@@ -22,8 +22,8 @@ from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 
-__all__ = ["ClosedLoop", "closed_loop", "closure_events", "event_recall", "lip_closures",
-           "lip_gap", "with_head_turns", "with_neutral_lead"]
+__all__ = ["ClosedLoop", "closed_loop", "closure_events", "closure_recall", "event_recall",
+           "false_closures", "lip_closures", "lip_gap", "with_head_turns", "with_neutral_lead"]
 
 BLINK_FAPS = (19, 20)
 """Upper-lid FAPs whose peaks are blinks."""
@@ -169,3 +169,25 @@ def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
     (rests between phrases are longer and are left out)."""
     runs = closure_events(-np.asarray(gap), -closed)
     return [(a, b) for a, b in runs if a > 0 and b < len(gap) and (b - a) / fps <= longest]
+
+
+def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *, closed: float = 0.1,
+                   slack: int = 2) -> float:
+    """Share of lip-closure ``events`` (runs ``[start, stop)``) during which the recovered
+    ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the recovered stream on the same face) also
+    falls below ``closed`` within ``slack`` frames: the avatar's lips touch. NaN if there
+    are no events."""
+    if not events:
+        return float("nan")
+    shut = np.asarray(gap) < closed
+    return sum(bool(shut[max(a - slack, 0): b + slack].any()) for a, b in events) / len(events)
+
+
+def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = 0.1,
+                   slack: int = 2) -> int:
+    """Runs of frames where the recovered ``gap`` ``(n,)`` is below ``closed`` but the
+    true ``truth_gap`` ``(n,)`` is not, in any frame of the run or within ``slack``: lips
+    that touch on the avatar and not in the source."""
+    shut = np.asarray(truth_gap) < closed
+    runs = closure_events(-np.asarray(gap), -closed)
+    return sum(not shut[max(a - slack, 0): b + slack].any() for a, b in runs)

@@ -36,6 +36,7 @@ from facelib.checks import check_fps
 from facelib.data import json_data
 from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
+from facelib.tracking import lipclosure
 from facelib.tracking.headframe import (
     HeadFrame,
     face_frame,
@@ -226,12 +227,30 @@ def _face_faps(frame: HeadFrame, layout: LandmarkLayout, span: slice, model: Mod
     return values, mask
 
 
+def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
+                 mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed mouth state (p, b, m) from MediaPipe's inner-lip aperture
+    (:mod:`~facelib.tracking.lipclosure`) applied to ``values``; others pass unchanged."""
+    if layout.name != "mediapipe" or frame.landmarks.shape[1] < 468:
+        return values, mask
+    rule = lipclosure.lip_closure()
+    closed = lipclosure.closed_frames(lipclosure.inner_lip_aperture(frame, rule),
+                                      close_below=rule.close_below,
+                                      open_above=rule.open_above)
+    mask = mask.copy()
+    mask[:, [3, 4, *(f - 1 for f in rule.neighbours)]] = True
+    return lipclosure.close_lips(values, closed, rule), mask
+
+
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
-            states: Mapping[str, np.ndarray] | None,
-            relations: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Smoothing, the floor of unidirectional FAPs, then eq. 4.17."""
+            states: Mapping[str, np.ndarray] | None, relations: bool,
+            lips: tuple[HeadFrame, LandmarkLayout] | None) -> tuple[np.ndarray, np.ndarray]:
+    """Smoothing, the closed lips of p/b/m (``lips``: where to read them), the floor of
+    unidirectional FAPs, then eq. 4.17."""
     if smooth:
         values = _smooth(values, mask, rate)
+    if lips is not None:
+        values, mask = _closed_lips(*lips, values, mask)
     for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
         if fap.bidirectional is False and fap.min == 0:
             values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
@@ -251,6 +270,7 @@ def measure_faps(
     states: Mapping[str, np.ndarray] | None = None,
     relations: bool = True,
     rig: Model | Literal["auto", "default", "observed"] | None = "auto",
+    close_lips: bool = True,
 ) -> TrackedFaps:
     """FAPs from landmark tracks; see the module docstring for the steps.
 
@@ -274,6 +294,9 @@ def measure_faps(
         landmarks (needs the ``mediapipe`` layout); ``"auto"`` (the default) is
         ``"observed"`` for 478 3-D MediaPipe landmarks and eq. 4.16 otherwise; None always
         uses eq. 4.16.
+    close_lips: with a model (``rig`` not None) on MediaPipe landmarks, detect the closed
+        mouth of p, b and m from the inner-lip aperture and close the lips in those frames
+        (:mod:`~facelib.tracking.lipclosure`).
     """
     rate = check_fps(fps)
     data, layout, model = _inputs(landmarks, layout, rig)
@@ -289,8 +312,9 @@ def measure_faps(
         for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
             values[:, fap_id - 1] = angle / ANGLE_UNIT
             mask[:, fap_id - 1] = True
+    lips = (frame, layout) if close_lips and model is not None else None
     values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
-                           relations=relations)
+                           relations=relations, lips=lips)
     return TrackedFaps(FapStream(rate, values, mask), frame.fapu, pose, filled)
 
 
