@@ -12,7 +12,12 @@ recall, for the learned observation model (the default, ``rig="observed"``) and,
 same landmarks, the default head's rig fit (``rig="default"``, the earlier method); then the
 same without the added head turns; then both on the SOMA-X head of ``examples/heads`` (set
 up with ``facelib.setup_face``), which neither model has seen; last the stylised cartoon
-head with head turns.
+head with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise,
+worry, sadness, fear and anger, which move the brows visibly, and gaze) with head turns on
+the default and SOMA-X heads. Lip closures: the p/b/m closures of the truth (inner-lip gap
+under 0.1 MNS0 for at most 0.4 s) during which the avatar's lips also touch, those after
+and before which they also part again (a closure held across several does not count), and
+the false closures (the avatar's lips touch where the source's do not).
 """
 
 from __future__ import annotations
@@ -27,7 +32,9 @@ from facelib.mpeg4 import FapStream
 from facelib.tracking.closedloop import (
     closed_loop,
     closure_events,
+    closure_recall,
     event_recall,
+    false_closures,
     lip_closures,
     lip_gap,
     with_head_turns,
@@ -60,10 +67,12 @@ def report(title: str, truth: FapStream, face: Face | None = None) -> None:
         stream = found[method].stream
         blinks = [event_recall(closure_events(truth.values[:, f - 1], 600),
                                stream.values[:, f - 1]) for f in (19, 20)]
-        lips = event_recall(closures, -lip_gap(face, stream))
+        gap = lip_gap(face, stream)
         print(f"  {method}: blinks recalled (FAP 19, 20) {blinks[0]:.0%}, {blinks[1]:.0%} of "
               f"{len(closure_events(truth.values[:, 18], 600))}; lip closures (p/b/m) "
-              f"{lips:.0%} of {len(closures)}")
+              f"{len(closures)}: lips touch in {closure_recall(closures, gap):.0%}, touch and "
+              f"part again in {closure_recall(closures, gap, truth_gap=truth_gap):.0%}; "
+              f"false closures {false_closures(truth_gap, gap)}")
     assert loop.frames is not None
     speed(loop.frames, loop.landmarks, truth.fps)
 
@@ -108,6 +117,10 @@ def main() -> None:
     cartoon = facelib.setup_face("examples/heads/cartoon_head.obj",
                                  landmarks="examples/heads/cartoon_landmarks.json")
     report("cartoon head, hello.fdl with head turns", with_head_turns(hello), cartoon)
+    expressive = facelib.run_fdl("examples/tracking/expressive.fdl").faps
+    report("expressive.fdl with head turns (brows: surprise, worry, sadness, fear, anger)",
+           with_head_turns(expressive))
+    report("SOMA-X head, expressive.fdl with head turns", with_head_turns(expressive), soma)
 
 
 if __name__ == "__main__":

@@ -171,16 +171,33 @@ def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
     return [(a, b) for a, b in runs if a > 0 and b < len(gap) and (b - a) / fps <= longest]
 
 
-def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *, closed: float = 0.1,
+def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,
+                   truth_gap: np.ndarray | None = None, closed: float = 0.1,
                    slack: int = 2) -> float:
     """Share of lip-closure ``events`` (runs ``[start, stop)``) during which the recovered
     ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the recovered stream on the same face) also
-    falls below ``closed`` within ``slack`` frames: the avatar's lips touch. NaN if there
+    falls below ``closed`` within ``slack`` frames: the avatar's lips touch. With
+    ``truth_gap`` ``(n,)`` (the true gap) a closure counts only if the avatar's lips also
+    part (``gap >= closed`` in some frame) in the stretches on either side where the
+    source's lips are apart, so one long closure does not count for several. NaN if there
     are no events."""
     if not events:
         return float("nan")
     shut = np.asarray(gap) < closed
-    return sum(bool(shut[max(a - slack, 0): b + slack].any()) for a, b in events) / len(events)
+    hits = [bool(shut[max(a - slack, 0): b + slack].any()) for a, b in events]
+    if truth_gap is not None:
+        apart = np.asarray(truth_gap) >= closed
+        hits = [hit and _parts(shut, apart, a, b) for hit, (a, b) in zip(hits, events,
+                                                                          strict=True)]
+    return sum(hits) / len(events)
+
+
+def _parts(shut: np.ndarray, apart: np.ndarray, start: int, stop: int) -> bool:
+    """Whether ``shut`` ``(n,) bool`` is False somewhere in each run of ``apart`` frames
+    next to ``[start, stop)`` (runs at the ends of the clip included)."""
+    runs = closure_events(apart.astype(np.float64), 0.5)
+    near = [(a, b) for a, b in runs if b == start or a == stop]
+    return all((~shut[a:b]).any() for a, b in near)
 
 
 def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = 0.1,
