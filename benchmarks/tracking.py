@@ -14,7 +14,7 @@ same without the added head turns; then both on the SOMA-X head of ``examples/he
 up with ``facelib.setup_face``), which neither model has seen; last the stylised cartoon
 head with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise,
 worry, sadness, fear and anger, which move the brows visibly, and gaze) with head turns on
-the default and SOMA-X heads. Lip closures: the p/b/m closures of the truth (inner-lip gap
+the default head, as scripted on it, and with head turns on the SOMA-X and cartoon heads. Lip closures: the p/b/m closures of the truth (inner-lip gap
 under 0.1 MNS0 for at most 0.4 s) during which the avatar's lips also touch, those after
 and before which they also part again (a closure held across several does not count), and
 the false closures (the avatar's lips touch where the source's do not).
@@ -120,7 +120,9 @@ def main() -> None:
     expressive = facelib.run_fdl("examples/tracking/expressive.fdl").faps
     report("expressive.fdl with head turns (brows: surprise, worry, sadness, fear, anger)",
            with_head_turns(expressive))
+    report("expressive.fdl as scripted", expressive)
     report("SOMA-X head, expressive.fdl with head turns", with_head_turns(expressive), soma)
+    report("cartoon head, expressive.fdl with head turns", with_head_turns(expressive), cartoon)
 
 
 if __name__ == "__main__":
