@@ -11,13 +11,14 @@ the correlation and gain of the recovered against the true curve, blink and lip-
 recall, for the learned observation model (the default, ``rig="observed"``) and, from the
 same landmarks, the default head's rig fit (``rig="default"``, the earlier method); then the
 same without the added head turns; then both on the SOMA-X head of ``examples/heads`` (set
-up with ``facelib.setup_face``), which neither model has seen; last the stylised cartoon
-head with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise,
-worry, sadness, fear and anger, which move the brows visibly, and gaze) with head turns on
-the default head, as scripted on it, and with head turns on the SOMA-X and cartoon heads. Lip closures: the p/b/m closures of the truth (inner-lip gap
-under 0.1 MNS0 for at most 0.4 s) during which the avatar's lips also touch, those after
-and before which they also part again (a closure held across several does not count), and
-the false closures (the avatar's lips touch where the source's do not).
+up with ``facelib.setup_face``), which neither model has seen; the stylised cartoon head
+with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise, worry,
+sadness, fear and anger, which move the brows visibly, and gaze) with head turns on the
+default head, as scripted on it, and with head turns on the SOMA-X and cartoon heads.
+Lip closures: the p/b/m closures of the truth (inner-lip gap under 0.1 MNS0 for at most
+0.4 s) during which the avatar's lips also touch, those after and before which they also
+part again (a closure held across several does not count), and the false closures (the
+avatar's lips touch where the source's do not).
 """
 
 from __future__ import annotations

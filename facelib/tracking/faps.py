@@ -49,6 +49,7 @@ from facelib.tracking.layouts import LandmarkLayout, landmark_layout
 from facelib.tracking.observation import (
     ObservationModel,
     default_observation,
+    pose_correction,
     solve_observation,
 )
 from facelib.tracking.pose import HeadPose, euler_angles
@@ -309,9 +310,12 @@ def measure_faps(
     values, mask = _face_faps(frame, layout, span, model)
     pose = frame.pose
     if pose is not None:
-        for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
-            values[:, fap_id - 1] = angle / ANGLE_UNIT
-            mask[:, fap_id - 1] = True
+        angles = np.stack(euler_angles(pose.rotation), axis=1)
+        if isinstance(model, ObservationModel):  # the fit's learned error taken out
+            angles += pose_correction(model, (frame.landmarks - frame.rest)[..., :2],
+                                      frame.fapu)
+        values[:, [f - 1 for f in _HEAD]] = angles / ANGLE_UNIT
+        mask[:, [f - 1 for f in _HEAD]] = True
     lips = (frame, layout) if close_lips and model is not None else None
     values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
                            relations=relations, lips=lips)

@@ -39,9 +39,10 @@ from facelib.errors import DataError, ParameterError, TrackingError
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, fap_table
 from facelib.tracking.headframe import head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
+from facelib.tracking.pose import euler_angles
 
 __all__ = ["MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
-           "learn_observation", "load_observation", "save_observation",
+           "learn_observation", "load_observation", "pose_correction", "save_observation",
            "solve_observation"]
 
 MODEL_FAPS = (3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 16, 17, 19, 20, 21, 22, 23, 24, 25, 26,
@@ -63,11 +64,18 @@ class ObservationModel:
         landmark's ``x, y`` motion (over ES0) in the neutral head's frame.
     bounds: ``(m, 2) float64`` lowest and highest FAP value (FAP units) seen in training,
         widened by a tenth of the range.
+    pose: ``(L, 2, 3) float64`` or None: the error of the rigid pose fit (true minus fitted
+        pitch, yaw, roll, radians) per unit of landmark motion, learned alike: expressions
+        move the fit's stable points (a smile lifts the nostrils and the fit reads a nod).
+    pose_bounds: ``(3, 2) float64`` or None: the range of that error in training, widened
+        by a tenth.
     """
 
     faps: np.ndarray
     estimator: np.ndarray
     bounds: np.ndarray
+    pose: np.ndarray | None = None
+    pose_bounds: np.ndarray | None = None
 
 
 def fap_lengths(faps: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
@@ -80,16 +88,18 @@ def fap_lengths(faps: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
 
 
 def _normalised(landmarks: np.ndarray, neutral: int | tuple[int, int]
-                ) -> tuple[np.ndarray, dict[str, float]]:
+                ) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
     """MediaPipe landmarks ``(n, 478, 3)`` -> displacements ``(n, 478, 2)`` over ES0 in the
-    neutral head frame, and the user's FAPU."""
+    neutral head frame, the user's FAPU and the fitted ``(n, 3)`` pitch, yaw, roll
+    (radians)."""
     data = np.asarray(landmarks, np.float64)
     layout = landmark_layout("mediapipe")
     frame = head_frame(data, layout=layout, span=neutral_span(neutral, len(data)))
     if frame.pose is None:
         raise TrackingError("the observation model needs a rigid head fit")
     es = frame.fapu["ES"] * FAPU_SCALE
-    return (frame.landmarks - frame.rest)[..., :2] / es, frame.fapu
+    angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
+    return (frame.landmarks - frame.rest)[..., :2] / es, frame.fapu, angles
 
 
 def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
@@ -102,7 +112,7 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     ``neutral``: the neutral frame(s); ``components``: principal components of the landmark
     motion the regression uses (fewer than frames).
     """
-    moved, fapu = _normalised(landmarks, neutral)
+    moved, fapu, fitted = _normalised(landmarks, neutral)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
     if components > n - 2:
@@ -111,14 +121,23 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     ids = np.asarray(faps, np.int64)
     truth = np.asarray(values, np.float64)[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
+    pose_error = np.asarray(values, np.float64)[:, 47:50] * ANGLE_UNIT - fitted
+    target = np.hstack([target, pose_error])
     flat = moved.reshape(n, -1)
     centre = flat.mean(axis=0)
     basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:components]  # (k, 2L)
     design = np.hstack([(flat - centre) @ basis.T, np.ones((n, 1))])
-    coef = np.linalg.lstsq(design, target, rcond=None)[0][:components]  # (k, m)
-    span = np.ptp(truth, axis=0)
-    bounds = np.stack([truth.min(axis=0) - 0.1 * span, truth.max(axis=0) + 0.1 * span], axis=1)
-    return ObservationModel(ids, (basis.T @ coef).reshape(n_land, 2, len(ids)), bounds)
+    coef = np.linalg.lstsq(design, target, rcond=None)[0][:components]  # (k, m + 3)
+    estimator = (basis.T @ coef).reshape(n_land, 2, len(ids) + 3)
+    return ObservationModel(ids, estimator[..., :-3], _range(truth), estimator[..., -3:],
+                            _range(pose_error))
+
+
+def _range(values: np.ndarray) -> np.ndarray:
+    """``(m, 2)`` lowest and highest of each column of ``(n, m)`` values, widened by a tenth
+    of the range."""
+    span = np.ptp(values, axis=0)
+    return np.stack([values.min(axis=0) - 0.1 * span, values.max(axis=0) + 0.1 * span], axis=1)
 
 
 def solve_observation(model: ObservationModel, displacements: np.ndarray,
@@ -133,33 +152,57 @@ def solve_observation(model: ObservationModel, displacements: np.ndarray,
     return np.clip(found, model.bounds[:, 0], model.bounds[:, 1])
 
 
+def pose_correction(model: ObservationModel, displacements: np.ndarray,
+                    fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, 3) float64`` correction (radians) to add to the fitted pitch, yaw and roll, from
+    ``(n, L, 2)`` landmark displacements (neutral head frame, the unit of ``fapu``), within
+    ``model.pose_bounds``; zeros for a model without one."""
+    n = len(displacements)
+    if model.pose is None or model.pose_bounds is None:
+        return np.zeros((n, 3))
+    moved = np.asarray(displacements, np.float64).reshape(n, -1) / (fapu["ES"] * FAPU_SCALE)
+    found = moved @ model.pose.reshape(moved.shape[1], 3)
+    return np.clip(found, model.pose_bounds[:, 0], model.pose_bounds[:, 1])
+
+
 def save_observation(model: ObservationModel, path: str | os.PathLike[str]) -> Path:
     """Write ``model`` as a compressed ``.npz`` (float32), atomically."""
     buffer = io.BytesIO()
+    pose = np.zeros((0, 2, 3)) if model.pose is None else model.pose
+    pose_bounds = np.zeros((0, 2)) if model.pose_bounds is None else model.pose_bounds
     np.savez_compressed(buffer, faps=model.faps.astype(np.int16),
                         estimator=model.estimator.astype(np.float32),
-                        bounds=model.bounds.astype(np.float32))
+                        bounds=model.bounds.astype(np.float32),
+                        pose=pose.astype(np.float32), pose_bounds=pose_bounds.astype(np.float32))
     with atomic_path(path) as temp:
         temp.write_bytes(buffer.getvalue())
     return Path(path)
 
 
 def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> ObservationModel:
-    """Read a model written by :func:`save_observation`; DataError if it is malformed."""
+    """Read a model written by :func:`save_observation` (the pose arrays may be absent or
+    empty); DataError if it is malformed."""
     where = str(source) if isinstance(source, (str, os.PathLike)) else _DATA
     try:
         with np.load(source, allow_pickle=False) as raw:
             arrays = {k: np.array(raw[k], np.float64) for k in ("faps", "estimator", "bounds")}
+            for key in ("pose", "pose_bounds"):
+                if key in raw.files and raw[key].size:
+                    arrays[key] = np.array(raw[key], np.float64)
     except (OSError, KeyError, ValueError) as exc:
         raise DataError(f"not an observation model ({exc})", path=where) from exc
     m = len(arrays["faps"])
-    if (arrays["faps"].ndim != 1 or arrays["estimator"].ndim != 3
-            or arrays["estimator"].shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2)):
+    shape = arrays["estimator"].shape
+    pose_ok = (("pose" in arrays) == ("pose_bounds" in arrays)
+               and arrays.get("pose", np.zeros((shape[0], 2, 3))).shape == (shape[0], 2, 3)
+               and arrays.get("pose_bounds", np.zeros((3, 2))).shape == (3, 2))
+    if (arrays["faps"].ndim != 1 or len(shape) != 3 or shape[1:] != (2, m)
+            or arrays["bounds"].shape != (m, 2) or not pose_ok):
         raise DataError("observation model arrays disagree in shape", path=where)
     for value in arrays.values():
         value.flags.writeable = False
     return ObservationModel(arrays["faps"].astype(np.int64), arrays["estimator"],
-                            arrays["bounds"])
+                            arrays["bounds"], arrays.get("pose"), arrays.get("pose_bounds"))
 
 
 @cache
