@@ -68,14 +68,21 @@ def report(title: str, truth: FapStream, face: Face | None = None) -> None:
         stream = found[method].stream
         blinks = [event_recall(closure_events(truth.values[:, f - 1], 600),
                                stream.values[:, f - 1]) for f in (19, 20)]
-        gap = lip_gap(face, stream)
         print(f"  {method}: blinks recalled (FAP 19, 20) {blinks[0]:.0%}, {blinks[1]:.0%} of "
-              f"{len(closure_events(truth.values[:, 18], 600))}; lip closures (p/b/m) "
-              f"{len(closures)}: lips touch in {closure_recall(closures, gap):.0%}, touch and "
-              f"part again in {closure_recall(closures, gap, truth_gap=truth_gap):.0%}; "
-              f"false closures {false_closures(truth_gap, gap)}")
+              f"{len(closure_events(truth.values[:, 18], 600))}; "
+              + lips(closures, truth_gap, lip_gap(face, stream)))
+    plain = loop.remeasure(close_lips=False).stream
+    print("  observed without the closed mouth state: "
+          + lips(closures, truth_gap, lip_gap(face, plain)))
     assert loop.frames is not None
     speed(loop.frames, loop.landmarks, truth.fps)
+
+
+def lips(closures: list[tuple[int, int]], truth_gap: np.ndarray, gap: np.ndarray) -> str:
+    return (f"lip closures (p/b/m) {len(closures)}: lips touch in "
+            f"{closure_recall(closures, gap):.0%}, touch and part again in "
+            f"{closure_recall(closures, gap, truth_gap=truth_gap):.0%}; "
+            f"false closures {false_closures(truth_gap, gap)}")
 
 
 def correlation(truth: FapStream, found: FapStream, fap_id: int) -> float:

@@ -155,9 +155,12 @@ def event_recall(events: list[tuple[int, int]], recovered: np.ndarray, *,
 
 def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
     """``(n,) float64`` vertical gap between the inner lip midpoints 2.2 and 2.3 of ``face``
-    deformed by ``stream``, in units of the face's MNS0 (0 = lips touching)."""
+    deformed by ``stream`` with the head kept still (FAPs 48-50 left out, so a head turn
+    does not change it), in units of the face's MNS0 (0 = lips touching)."""
     top, bottom = face.feature_points["2.2"], face.feature_points["2.3"]
-    moved = face.deform(stream)
+    values = np.array(stream.values)
+    values[:, 47:50] = 0.0
+    moved = face.deform(FapStream(stream.fps, values, stream.mask))
     return (moved[:, top, 1] - moved[:, bottom, 1]).astype(np.float64) / (
         face.fapu["MNS"] * 1024)
 
