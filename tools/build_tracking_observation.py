@@ -18,7 +18,8 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
    ``out/tracking_observation_training.npz`` and ``out/tracking_observation_speech.npz``
    (re-used unless ``--fresh``).
 3. :func:`facelib.tracking.observation.learn_observation` fits the observation model and
-   it is written to ``facelib/data/tracking/observation_mediapipe.npz``; the closed-lips
+   it is written to ``facelib/data/tracking/observation_mediapipe.npz`` (the FAP estimator
+   and the rigid pose fit's learned error); the closed-lips
    threshold of :mod:`facelib.tracking.lipclosure` is learned from the random stream's
    frames and written into ``facelib/data/tracking/lip_closure.json``.
 
