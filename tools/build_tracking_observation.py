@@ -4,11 +4,11 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
 
     OMP_NUM_THREADS=1 python tools/build_tracking_observation.py [--frames 3000] [--seeds 7 8]
 
-1. Training streams are drawn at random (one per seed): every 3 frames a new face pose (a random
-   viseme and expression of facelib's own libraries at random weights, plus independent
+1. Training streams are drawn at random (one per seed): every 3 frames a new face pose (a
+   random viseme and expression of facelib's own libraries at random weights, plus independent
    random pushes of every modelled FAP, lids, blinks and gaze), every 12 frames a new head
    pose (yaw up to 25 degrees, pitch 12, roll 10), linearly interpolated between, after 8
-   neutral frames. With ``--speech`` a second, speech-like stream follows: storyboards made
+   neutral frames. With ``--speech`` a speech-like stream follows: storyboards made
    up here (the sentences below, random expressions and eye behaviours) animated by
    facelib, with slow random head sweeps (tried, not used for the packaged model: see
    ``docs/performance-driven.md``). Neither shares anything with
@@ -66,8 +66,9 @@ OUT = ROOT / "facelib" / "data" / "tracking" / "observation_mediapipe.npz"
 CLOSURE = ROOT / "facelib" / "data" / "tracking" / "lip_closure.json"
 FPS = 25.0
 SEEDS = (7, 8)
-"""The training streams' seeds: two streams of 3000 frames (one alone gave correlations
-0.01-0.1 lower for most FAPs of the closed loop; see docs/performance-driven.md)."""
+"""The training streams' seeds: two streams of 3000 frames (with one alone most FAPs of the
+closed loop correlate 0.01-0.12 less, a few 0.01-0.02 more; a third stream changed them by
+0.02 either way; see docs/performance-driven.md)."""
 NEUTRAL = 8
 FACE_STEP, HEAD_STEP = 3, 12
 EXTRA_FAPS = (18, 44, 45, 46, 63, 81, 82)
