@@ -17,9 +17,11 @@ The chain, each step a function over arrays:
    for MediaPipe's 478 landmarks in 3-D, by default, the learned observation model
    (:mod:`~facelib.tracking.observation`) replaces this step and the next one's gaze;
 5. gaze 23-26 from the pupils' motion relative to the eye corners (eyeball radius from the
-   eye width), head pitch/yaw/roll 48-50 from the fit;
-6. One Euro smoothing (blinks and closures keep their depth), then the FAP relationships of
-   eq. 4.17 (and high-level states such as pucker) fill untracked FAPs.
+   eye width), head pitch/yaw/roll 48-50 from the fit (with the learned model, plus its
+   estimate of the fit's error);
+6. One Euro smoothing (blinks and closures keep their depth), the closed mouth of p/b/m
+   (:mod:`~facelib.tracking.lipclosure`), then the FAP relationships of eq. 4.17 (and
+   high-level states such as pucker) fill untracked FAPs.
 """
 
 from __future__ import annotations

@@ -19,6 +19,11 @@ motion between them (open_jaw r = 0.72-0.78 on the closed loop), where the learn
 carries the statistics of facelib's visemes and expressions (r = 0.88). Both sides are
 measured on the tracker's own landmarks in the user's FAPU, so the model carries over to
 other faces.
+
+The same regression learns the rigid pose fit's error (true minus fitted pitch, yaw and
+roll): expressions move the fit's stable points (a smile lifts the nostrils, which the fit
+alone reads as a nod of several degrees); tracking adds the estimate to the fitted angles
+(:func:`pose_correction`).
 """
 
 from __future__ import annotations
@@ -191,13 +196,14 @@ def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> Obse
                     arrays[key] = np.array(raw[key], np.float64)
     except (OSError, KeyError, ValueError) as exc:
         raise DataError(f"not an observation model ({exc})", path=where) from exc
-    m = len(arrays["faps"])
+    m = len(arrays["faps"]) if arrays["faps"].ndim == 1 else -1
     shape = arrays["estimator"].shape
-    pose_ok = (("pose" in arrays) == ("pose_bounds" in arrays)
-               and arrays.get("pose", np.zeros((shape[0], 2, 3))).shape == (shape[0], 2, 3)
-               and arrays.get("pose_bounds", np.zeros((3, 2))).shape == (3, 2))
-    if (arrays["faps"].ndim != 1 or len(shape) != 3 or shape[1:] != (2, m)
-            or arrays["bounds"].shape != (m, 2) or not pose_ok):
+    pose_ok = len(shape) == 3 and (("pose" in arrays) == ("pose_bounds" in arrays)
+                                   and arrays.get("pose", np.zeros((shape[0], 2, 3))).shape
+                                   == (shape[0], 2, 3)
+                                   and arrays.get("pose_bounds", np.zeros((3, 2))).shape
+                                   == (3, 2))
+    if m < 0 or not pose_ok or shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
         raise DataError("observation model arrays disagree in shape", path=where)
     for value in arrays.values():
         value.flags.writeable = False
