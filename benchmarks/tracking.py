@@ -8,9 +8,17 @@ Renders ``examples/hello/hello.fdl`` (speech, expressions, gaze, blinks) at 640x
 added head turns (yaw up to 20 degrees, pitch 10, roll 8), tracks the video with MediaPipe,
 recovers the FAPs and prints: MediaPipe frames/s, landmarks-to-FAPs frames/s, and per FAP
 the correlation and gain of the recovered against the true curve, blink and lip-closure
-recall; then the same without the added head turns; then both on the SOMA-X head of
-``examples/heads`` (set up with ``facelib.setup_face``), which the default head's rig
-model has never seen.
+recall, for the learned observation model (the default, ``rig="observed"``) and, from the
+same landmarks, the default head's rig fit (``rig="default"``, the earlier method); then the
+same without the added head turns; then both on the SOMA-X head of ``examples/heads`` (set
+up with ``facelib.setup_face``), which neither model has seen; the stylised cartoon head
+with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise, worry,
+sadness, fear and anger, which move the brows visibly, and gaze) with head turns on the
+default head, as scripted on it, and with head turns on the SOMA-X and cartoon heads.
+Lip closures: the p/b/m closures of the truth (inner-lip gap under 0.1 MNS0 for at most
+0.4 s) during which the avatar's lips also touch, those after and before which they also
+part again (a closure held across several does not count), and the false closures (the
+avatar's lips touch where the source's do not).
 """
 
 from __future__ import annotations
@@ -25,7 +33,9 @@ from facelib.mpeg4 import FapStream
 from facelib.tracking.closedloop import (
     closed_loop,
     closure_events,
+    closure_recall,
     event_recall,
+    false_closures,
     lip_closures,
     lip_gap,
     with_head_turns,
@@ -33,7 +43,10 @@ from facelib.tracking.closedloop import (
 from facelib.tracking.faps import measure_faps
 from facelib.tracking.mediapipe import FaceMeshTracker
 
-FAPS = (3, 53, 54, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
+FAPS = (3, 6, 7, 12, 13, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
+"""The FAPs hello.fdl moves that the issue's closed loop names (lip corners: 6/7 and
+12/13, the outer 59/60 barely move; 53/54 not at all)."""
+METHODS = ("observed", "default")
 
 
 def report(title: str, truth: FapStream, face: Face | None = None) -> None:
@@ -41,21 +54,47 @@ def report(title: str, truth: FapStream, face: Face | None = None) -> None:
     loop = closed_loop(truth, face=face, keep_frames=True)
     print(f"\n{title}: {truth.n_frames} frames, closed loop in "
           f"{time.perf_counter() - started:.1f} s")
-    print(f"  {'FAP':>3}  {'name':<22} {'corr':>6} {'gain':>6}")
+    found = {"observed": loop.tracked, "default": loop.remeasure(rig="default")}
+    print(f"  {'FAP':>3}  {'name':<22} " + " ".join(f"{m + ' corr':>13} {'gain':>5}"
+                                                     for m in METHODS))
     for fap_id in FAPS:
-        print(f"  {fap_id:>3}  {facelib.fap(fap_id).name:<22} {loop.correlation(fap_id):6.3f} "
-              f"{loop.gain(fap_id):6.2f}")
-    for fap_id in (19, 20):
-        events = closure_events(truth.values[:, fap_id - 1], 600)
-        recall = event_recall(events, loop.tracked.stream.values[:, fap_id - 1])
-        print(f"  blinks (FAP {fap_id}): {len(events)}, recalled {recall:.0%}")
+        cells = " ".join(f"{correlation(truth, found[m].stream, fap_id):13.3f} "
+                         f"{gain(truth, found[m].stream, fap_id):5.2f}" for m in METHODS)
+        print(f"  {fap_id:>3}  {facelib.fap(fap_id).name:<22} {cells}")
     face = default_face() if face is None else face
     truth_gap = lip_gap(face, truth)
-    events = lip_closures(truth_gap, truth.fps)
-    recall = event_recall(events, -lip_gap(face, loop.tracked.stream))
-    print(f"  lip closures (p/b/m): {len(events)}, recalled {recall:.0%}")
+    closures = lip_closures(truth_gap, truth.fps)
+    for method in METHODS:
+        stream = found[method].stream
+        blinks = [event_recall(closure_events(truth.values[:, f - 1], 600),
+                               stream.values[:, f - 1]) for f in (19, 20)]
+        print(f"  {method}: blinks recalled (FAP 19, 20) {blinks[0]:.0%}, {blinks[1]:.0%} of "
+              f"{len(closure_events(truth.values[:, 18], 600))}; "
+              + lips(closures, truth_gap, lip_gap(face, stream)))
+    plain = loop.remeasure(close_lips=False).stream
+    print("  observed without the closed mouth state: "
+          + lips(closures, truth_gap, lip_gap(face, plain)))
     assert loop.frames is not None
     speed(loop.frames, loop.landmarks, truth.fps)
+
+
+def lips(closures: list[tuple[int, int]], truth_gap: np.ndarray, gap: np.ndarray) -> str:
+    return (f"lip closures (p/b/m) {len(closures)}: lips touch in "
+            f"{closure_recall(closures, gap):.0%}, touch and part again in "
+            f"{closure_recall(closures, gap, truth_gap=truth_gap):.0%}; "
+            f"false closures {false_closures(truth_gap, gap)}")
+
+
+def correlation(truth: FapStream, found: FapStream, fap_id: int) -> float:
+    a, b = truth.values[:, fap_id - 1], found.values[:, fap_id - 1]
+    return float(np.corrcoef(a, b)[0, 1]) if a.std() > 0 and b.std() > 0 else float("nan")
+
+
+def gain(truth: FapStream, found: FapStream, fap_id: int) -> float:
+    a = truth.values[:, fap_id - 1].astype(np.float64)
+    b = found.values[:, fap_id - 1].astype(np.float64)
+    a = a - a.mean()
+    return float(a @ (b - b.mean()) / (a @ a)) if a @ a > 0 else float("nan")
 
 
 def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
@@ -64,7 +103,7 @@ def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
         for image in frames:
             tracker.detect(image)
         track_s = time.perf_counter() - started
-    measure_faps(landmarks[:10], fps=fps)  # warm the cached rig model
+    measure_faps(landmarks[:10], fps=fps)  # warm the cached model
     started = time.perf_counter()
     measure_faps(landmarks, fps=fps)
     faps_s = time.perf_counter() - started
@@ -83,6 +122,15 @@ def main() -> None:
                               landmarks="examples/heads/soma_landmarks.json")
     report("SOMA-X head, hello.fdl with head turns", with_head_turns(hello), soma)
     report("SOMA-X head, hello.fdl as scripted", hello, soma)
+    cartoon = facelib.setup_face("examples/heads/cartoon_head.obj",
+                                 landmarks="examples/heads/cartoon_landmarks.json")
+    report("cartoon head, hello.fdl with head turns", with_head_turns(hello), cartoon)
+    expressive = facelib.run_fdl("examples/tracking/expressive.fdl").faps
+    report("expressive.fdl with head turns (brows: surprise, worry, sadness, fear, anger)",
+           with_head_turns(expressive))
+    report("expressive.fdl as scripted", expressive)
+    report("SOMA-X head, expressive.fdl with head turns", with_head_turns(expressive), soma)
+    report("cartoon head, expressive.fdl with head turns", with_head_turns(expressive), cartoon)
 
 
 if __name__ == "__main__":

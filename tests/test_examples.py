@@ -73,3 +73,12 @@ def test_python_examples_run(tmp_path, script, outputs):
         original = read_fap(EXAMPLES / "fap" / "xface_smile.fap")
         again = read_fap(tmp_path / outputs[0], strict=True)
         assert np.abs(again.values - original.values).max() <= 0.5
+
+
+def test_expressive_storyboard_moves_the_brows():
+    # the closed-loop stream for the brows (benchmarks/tracking.py): speech with surprise,
+    # worry, sadness, fear and anger
+    faps = _quiet_run(EXAMPLES / "tracking" / "expressive.fdl").faps
+    brow = faps.values[:, fap("raise_l_i_eyebrow").index]
+    assert brow.max() > 80 and brow.min() < -5
+    assert faps.values[:, fap("open_jaw").index].max() > 300   # it speaks

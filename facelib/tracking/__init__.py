@@ -8,8 +8,10 @@ other trackers need only numpy.
 Submodules: :mod:`~facelib.tracking.layouts` (tracker points -> feature points),
 :mod:`~facelib.tracking.mediapipe` (478 landmarks in RGB images),
 :mod:`~facelib.tracking.faps` (landmarks -> FapStream: ``measure_faps``,
-``landmarks_to_faps``), :mod:`~facelib.tracking.userfapu` (eq. 4.12-4.15),
-:mod:`~facelib.tracking.pose` (head pose), :mod:`~facelib.tracking.rigfit` (the avatar's
+``landmarks_to_faps``), :mod:`~facelib.tracking.headframe` (landmarks in the neutral
+head's frame), :mod:`~facelib.tracking.userfapu` (eq. 4.12-4.15),
+:mod:`~facelib.tracking.pose` (head pose), :mod:`~facelib.tracking.observation` (the
+learned landmarks-to-FAPs model), :mod:`~facelib.tracking.rigfit` (the avatar's
 rig fitted to the landmark motion), :mod:`~facelib.tracking.embedding` (landmarks on a
 mesh), :mod:`~facelib.tracking.relations` (eq. 4.17), :mod:`~facelib.tracking.smoothing`
 (One Euro), :mod:`~facelib.tracking.video` (video in), :mod:`~facelib.tracking.files`

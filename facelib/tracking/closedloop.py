@@ -16,13 +16,14 @@ import numpy as np
 
 from facelib.checks import check_count
 from facelib.engine import Face, default_face
+from facelib.errors import ParameterError
 from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 
-__all__ = ["ClosedLoop", "closed_loop", "closure_events", "event_recall", "lip_closures",
-           "lip_gap", "with_head_turns", "with_neutral_lead"]
+__all__ = ["ClosedLoop", "closed_loop", "closure_events", "closure_recall", "event_recall",
+           "false_closures", "lip_closures", "lip_gap", "with_head_turns", "with_neutral_lead"]
 
 BLINK_FAPS = (19, 20)
 """Upper-lid FAPs whose peaks are blinks."""
@@ -38,12 +39,24 @@ class ClosedLoop:
     tracked: what tracking recovered (same frame count).
     landmarks: ``(n, 478, 3)`` MediaPipe landmarks of the render.
     frames: ``(n, H, W, 3) uint8`` the rendered frames (None unless ``keep_frames``).
+    lead: ``(k, 478, 3)`` landmarks of the neutral lead frames (cut from ``landmarks``).
     """
 
     truth: FapStream
     tracked: TrackedFaps
     landmarks: np.ndarray
     frames: np.ndarray | None
+    lead: np.ndarray | None = None
+
+    def remeasure(self, **options: Any) -> TrackedFaps:
+        """The same landmarks measured again with other ``options`` of
+        :func:`~facelib.tracking.faps.measure_faps` (e.g. ``rig="default"``), lead cut."""
+        if self.lead is None or not len(self.lead):
+            raise ParameterError("this closed loop kept no neutral lead frames")
+        k = len(self.lead)
+        found = measure_faps(np.concatenate([self.lead, self.landmarks]), fps=self.truth.fps,
+                             neutral=(0, k), **options)
+        return _trim(found, k)
 
     def correlation(self, fap_id: int) -> float:
         """Pearson correlation of the true and recovered curves of FAP ``fap_id`` (NaN if
@@ -108,11 +121,16 @@ def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: 
     tracked = measure_faps(points, fps=stream.fps, neutral=(0, max(neutral_frames, 1)),
                            **options)
     cut = slice(neutral_frames, None)
-    trimmed = TrackedFaps(tracked.stream[cut], tracked.fapu, tracked.pose,
-                          tuple(f - neutral_frames for f in tracked.filled_frames
-                                if f >= neutral_frames))
-    return ClosedLoop(FapStream(stream.fps, stream.values, stream.mask), trimmed, points[cut],
-                      np.stack(rendered)[cut] if keep_frames else None)
+    return ClosedLoop(FapStream(stream.fps, stream.values, stream.mask),
+                      _trim(tracked, neutral_frames), points[cut],
+                      np.stack(rendered)[cut] if keep_frames else None,
+                      points[:neutral_frames])
+
+
+def _trim(tracked: TrackedFaps, lead: int) -> TrackedFaps:
+    """``tracked`` without its first ``lead`` frames."""
+    return TrackedFaps(tracked.stream[lead:], tracked.fapu, tracked.pose,
+                       tuple(f - lead for f in tracked.filled_frames if f >= lead))
 
 
 def closure_events(signal: np.ndarray, threshold: float) -> list[tuple[int, int]]:
@@ -137,9 +155,12 @@ def event_recall(events: list[tuple[int, int]], recovered: np.ndarray, *,
 
 def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
     """``(n,) float64`` vertical gap between the inner lip midpoints 2.2 and 2.3 of ``face``
-    deformed by ``stream``, in units of the face's MNS0 (0 = lips touching)."""
+    deformed by ``stream`` with the head kept still (FAPs 48-50 left out, so a head turn
+    does not change it), in units of the face's MNS0 (0 = lips touching)."""
     top, bottom = face.feature_points["2.2"], face.feature_points["2.3"]
-    moved = face.deform(stream)
+    values = np.array(stream.values)
+    values[:, 47:50] = 0.0
+    moved = face.deform(FapStream(stream.fps, values, stream.mask))
     return (moved[:, top, 1] - moved[:, bottom, 1]).astype(np.float64) / (
         face.fapu["MNS"] * 1024)
 
@@ -151,3 +172,42 @@ def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
     (rests between phrases are longer and are left out)."""
     runs = closure_events(-np.asarray(gap), -closed)
     return [(a, b) for a, b in runs if a > 0 and b < len(gap) and (b - a) / fps <= longest]
+
+
+def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,
+                   truth_gap: np.ndarray | None = None, closed: float = 0.1,
+                   slack: int = 2) -> float:
+    """Share of lip-closure ``events`` (runs ``[start, stop)``) during which the recovered
+    ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the recovered stream on the same face) also
+    falls below ``closed`` within ``slack`` frames: the avatar's lips touch. With
+    ``truth_gap`` ``(n,)`` (the true gap) a closure counts only if the avatar's lips also
+    part (``gap >= closed`` in some frame) in the stretches on either side where the
+    source's lips are apart, so one long closure does not count for several. NaN if there
+    are no events."""
+    if not events:
+        return float("nan")
+    shut = np.asarray(gap) < closed
+    hits = [bool(shut[max(a - slack, 0): b + slack].any()) for a, b in events]
+    if truth_gap is not None:
+        apart = np.asarray(truth_gap) >= closed
+        hits = [hit and _parts(shut, apart, a, b) for hit, (a, b) in zip(hits, events,
+                                                                          strict=True)]
+    return sum(hits) / len(events)
+
+
+def _parts(shut: np.ndarray, apart: np.ndarray, start: int, stop: int) -> bool:
+    """Whether ``shut`` ``(n,) bool`` is False somewhere in each run of ``apart`` frames
+    next to ``[start, stop)`` (runs at the ends of the clip included)."""
+    runs = closure_events(apart.astype(np.float64), 0.5)
+    near = [(a, b) for a, b in runs if b == start or a == stop]
+    return all((~shut[a:b]).any() for a, b in near)
+
+
+def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = 0.1,
+                   slack: int = 2) -> int:
+    """Runs of frames where the recovered ``gap`` ``(n,)`` is below ``closed`` but the
+    true ``truth_gap`` ``(n,)`` is not, in any frame of the run or within ``slack``: lips
+    that touch on the avatar and not in the source."""
+    shut = np.asarray(truth_gap) < closed
+    runs = closure_events(-np.asarray(gap), -closed)
+    return sum(not shut[max(a - slack, 0): b + slack].any() for a, b in runs)

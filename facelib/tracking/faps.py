@@ -13,10 +13,15 @@ The chain, each step a function over arrays:
 4. per-axis displacements of each tracked feature point from its neutral position divided by
    the FAP's unit, signed by the FAP table's direction (eq. 4.16 read per axis, not as the
    printed scalar distance); eyelids 19-22 are the lid points' vertical motion in IRISD;
+   optionally refined by fitting a face's rig (:mod:`~facelib.tracking.rigfit`);
+   for MediaPipe's 478 landmarks in 3-D, by default, the learned observation model
+   (:mod:`~facelib.tracking.observation`) replaces this step and the next one's gaze;
 5. gaze 23-26 from the pupils' motion relative to the eye corners (eyeball radius from the
-   eye width), head pitch/yaw/roll 48-50 from the fit;
-6. One Euro smoothing (blinks and closures keep their depth), then the FAP relationships of
-   eq. 4.17 (and high-level states such as pucker) fill untracked FAPs.
+   eye width), head pitch/yaw/roll 48-50 from the fit (with the learned model, plus its
+   estimate of the fit's error);
+6. One Euro smoothing (blinks and closures keep their depth), the closed mouth of p/b/m
+   (:mod:`~facelib.tracking.lipclosure`), then the FAP relationships of eq. 4.17 (and
+   high-level states such as pucker) fill untracked FAPs.
 """
 
 from __future__ import annotations
@@ -33,15 +38,23 @@ from facelib.checks import check_fps
 from facelib.data import json_data
 from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
-from facelib.tracking.layouts import LandmarkLayout, landmark_layout
-from facelib.tracking.pose import (
-    HeadPose,
-    euler_angles,
-    fit_pose,
-    refine_pose_2d,
-    unpose,
-    unpose_2d,
+from facelib.tracking import lipclosure
+from facelib.tracking.headframe import (
+    HeadFrame,
+    face_frame,
+    fill_gaps,
+    frame_spans,
+    head_frame,
+    neutral_span,
 )
+from facelib.tracking.layouts import LandmarkLayout, landmark_layout
+from facelib.tracking.observation import (
+    ObservationModel,
+    default_observation,
+    pose_correction,
+    solve_observation,
+)
+from facelib.tracking.pose import HeadPose, euler_angles
 from facelib.tracking.relations import apply_relations
 from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
@@ -77,72 +90,6 @@ class TrackedFaps:
 @cache
 def _model() -> dict[str, dict[str, float]]:
     return json_data("tracking/model.json")
-
-
-def face_frame(landmarks: np.ndarray) -> np.ndarray:
-    """Image coordinates (column, row[, depth toward the scene]) -> the face frame (``x``
-    right in the image = the face's left, ``y`` up, ``z`` toward the camera). Same shape."""
-    out = np.array(landmarks, np.float64)
-    out[..., 1:] *= -1.0
-    return out
-
-
-def frame_spans(frames: np.ndarray) -> str:
-    """Frame indices (sorted) as text: ``"3-7, 12"``."""
-    parts, start = [], None
-    for i, f in enumerate(frames):
-        if start is None:
-            start = f
-        if i + 1 == len(frames) or frames[i + 1] != f + 1:
-            parts.append(f"{start}" if start == f else f"{start}-{f}")
-            start = None
-    return ", ".join(parts)
-
-
-def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
-    """Interpolate frames whose landmarks hold NaN (no face) linearly in time.
-
-    ``(n, K, D)`` -> (filled copy, the filled frame indices). Frames before the first or
-    after the last face hold the nearest face. TrackingError if no frame has a face.
-    """
-    data = np.array(landmarks, np.float64)
-    lost = ~np.isfinite(data).reshape(len(data), -1).all(axis=1)
-    if not lost.any():
-        return data, ()
-    good = np.flatnonzero(~lost)
-    if not good.size:
-        raise TrackingError(f"no face in any of the {len(data)} frames")
-    flat = data.reshape(len(data), -1)
-    idx = np.arange(len(data))
-    for col in range(flat.shape[1]):
-        flat[lost, col] = np.interp(idx[lost], good, flat[good, col])
-    return data, tuple(int(i) for i in np.flatnonzero(lost))
-
-
-def _neutral_span(neutral: int | tuple[int, int], n: int) -> slice:
-    start, stop = (neutral, neutral + 1) if isinstance(neutral, int) else neutral
-    if not 0 <= start < stop <= n:
-        raise ParameterError(f"neutral frames {neutral!r} are outside the {n} frames")
-    return slice(start, stop)
-
-
-def _remove_pose(points: np.ndarray, layout: LandmarkLayout, span: slice,
-                 rest_all: np.ndarray) -> tuple[np.ndarray, HeadPose | None]:
-    """All landmarks ``(n, K, D)`` in the neutral head's frame, and the fit."""
-    dim = points.shape[2]
-    if len(layout.stable) > dim:
-        stable = points[:, layout.stable]
-        rest = rest_all[layout.stable]
-        pose = fit_pose(rest, stable)
-        if dim == 2:
-            return unpose(points, pose), pose
-        pose = refine_pose_2d(rest, stable, pose)
-        return unpose_2d(points, rest_all, pose), pose
-    if "9.3" not in layout.feature_points:
-        raise TrackingError("without stable points the nose tip 9.3 must be tracked "
-                            "(the seed's reference point)")
-    nose = layout.feature_point_positions(points)[:, layout.index("9.3")]
-    return points - (nose - nose[span].mean(axis=0))[:, None, :], None
 
 
 def _plan(layout: LandmarkLayout, pose: HeadPose | None
@@ -227,28 +174,86 @@ def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     return out
 
 
+Model = RigModel | ObservationModel
+"""What :func:`measure_faps` fits to the landmark motion."""
+
+
 def _inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
-            rig: RigModel | Literal["auto", "default"] | None
-            ) -> tuple[np.ndarray, LandmarkLayout, RigModel | None]:
-    """Checked ``(n, K, D)`` landmarks, the layout, and the rig model to fit (or None)."""
+            rig: Model | Literal["auto", "default", "observed"] | None
+            ) -> tuple[np.ndarray, LandmarkLayout, Model | None]:
+    """Checked ``(n, K, D)`` landmarks, the layout, and the model to fit (or None)."""
     data = np.asarray(landmarks, np.float64)
     if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
         raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
     if isinstance(layout, str):
         layout = landmark_layout(layout, data.shape[1])
+    mediapipe_3d = layout.name == "mediapipe" and data.shape[2] == 3
     if rig == "auto":
-        rig = "default" if layout.name == "mediapipe" and data.shape[2] == 3 else None
+        rig = "observed" if mediapipe_3d and layout.n_points == 478 else None
     if rig == "default" and layout.name != "mediapipe":
         raise ParameterError(f"rig='default' needs MediaPipe landmarks, not {layout.name!r}")
-    return data, layout, default_rig() if rig == "default" else rig
+    if (rig == "observed" or isinstance(rig, ObservationModel)) and not (
+            mediapipe_3d and layout.n_points == 478):
+        raise ParameterError("the observation model needs MediaPipe's 478 landmarks in 3-D")
+    if rig == "default":
+        return data, layout, default_rig()
+    if rig == "observed":
+        return data, layout, default_observation()
+    return data, layout, rig
+
+
+def _observe(frame: HeadFrame, model: ObservationModel, *, values: np.ndarray,
+             mask: np.ndarray) -> None:
+    """FAPs of ``model`` from the landmark motion (:mod:`~facelib.tracking.observation`)."""
+    found = solve_observation(model, (frame.landmarks - frame.rest)[..., :2], frame.fapu)
+    values[:, model.faps - 1] = found
+    mask[:, model.faps - 1] = True
+
+
+def _face_faps(frame: HeadFrame, layout: LandmarkLayout, span: slice, model: Model | None
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """``(n, 84)`` values and mask of the face FAPs: the learned model, or eq. 4.16 (refined
+    by a rig fit) and the gaze of the pupils."""
+    n = len(frame.landmarks)
+    values = np.zeros((n, N_FAPS))
+    mask = np.zeros((n, N_FAPS), bool)
+    if isinstance(model, ObservationModel):
+        _observe(frame, model, values=values, mask=mask)
+        return values, mask
+    moved = frame.points - frame.rest_points
+    for col, row, axis, sign, unit in _plan(layout, frame.pose):  # eq. 4.16, per axis
+        values[:, col] = sign * moved[:, row, axis] / frame.fapu[unit]
+        mask[:, col] = True
+    if model is not None:
+        _fit(frame.landmarks, span, frame.fapu, model, values=values, mask=mask)
+    _gaze(frame.points, layout, span, values, mask)
+    return values, mask
+
+
+def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
+                 mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed mouth state (p, b, m) from MediaPipe's inner-lip aperture
+    (:mod:`~facelib.tracking.lipclosure`) applied to ``values``; others pass unchanged."""
+    if layout.name != "mediapipe" or frame.landmarks.shape[1] < 468:
+        return values, mask
+    rule = lipclosure.lip_closure()
+    closed = lipclosure.closed_frames(lipclosure.inner_lip_aperture(frame, rule),
+                                      close_below=rule.close_below,
+                                      open_above=rule.open_above)
+    mask = mask.copy()
+    mask[:, [3, 4, *(f - 1 for f in rule.neighbours)]] = True
+    return lipclosure.close_lips(values, closed, rule), mask
 
 
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
-            states: Mapping[str, np.ndarray] | None,
-            relations: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Smoothing, the floor of unidirectional FAPs, then eq. 4.17."""
+            states: Mapping[str, np.ndarray] | None, relations: bool,
+            lips: tuple[HeadFrame, LandmarkLayout] | None) -> tuple[np.ndarray, np.ndarray]:
+    """Smoothing, the closed lips of p/b/m (``lips``: where to read them), the floor of
+    unidirectional FAPs, then eq. 4.17."""
     if smooth:
         values = _smooth(values, mask, rate)
+    if lips is not None:
+        values, mask = _closed_lips(*lips, values, mask)
     for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
         if fap.bidirectional is False and fap.min == 0:
             values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
@@ -267,7 +272,8 @@ def measure_faps(
     smooth: bool = True,
     states: Mapping[str, np.ndarray] | None = None,
     relations: bool = True,
-    rig: RigModel | Literal["auto", "default"] | None = "auto",
+    rig: Model | Literal["auto", "default", "observed"] | None = "auto",
+    close_lips: bool = True,
 ) -> TrackedFaps:
     """FAPs from landmark tracks; see the module docstring for the steps.
 
@@ -283,11 +289,17 @@ def measure_faps(
     smooth: apply the One Euro filter.
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
     relations: fill untracked FAPs by eq. 4.17.
-    rig: fit this face's rig to the landmark motion (:mod:`~facelib.tracking.rigfit`) for
-        the FAPs it models, instead of eq. 4.16's one point per FAP; ``"default"`` is the
-        default head with MediaPipe landmarks (needs the ``mediapipe`` layout); ``"auto"``
-        (the default) uses it for 3-D MediaPipe landmarks and eq. 4.16 otherwise; None
-        always uses eq. 4.16.
+    rig: the model read off the landmark motion instead of eq. 4.16's one point per FAP:
+        ``"observed"`` (or an :class:`~facelib.tracking.observation.ObservationModel`) the
+        observation model learned from renders (needs MediaPipe's 478 landmarks in 3-D;
+        it also gives gaze); ``"default"`` (or a
+        :class:`~facelib.tracking.rigfit.RigModel`) the default head's rig fitted to the
+        landmarks (needs the ``mediapipe`` layout); ``"auto"`` (the default) is
+        ``"observed"`` for 478 3-D MediaPipe landmarks and eq. 4.16 otherwise; None always
+        uses eq. 4.16.
+    close_lips: with a model (``rig`` not None) on MediaPipe landmarks, detect the closed
+        mouth of p, b and m from the inner-lip aperture and close the lips in those frames
+        (:mod:`~facelib.tracking.lipclosure`).
     """
     rate = check_fps(fps)
     data, layout, model = _inputs(landmarks, layout, rig)
@@ -295,27 +307,21 @@ def measure_faps(
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
-    points = face_frame(data)
-    span = _neutral_span(neutral, len(data))
-    local_all, pose = _remove_pose(points, layout, span, points[span].mean(axis=0))
-    local = layout.feature_point_positions(local_all)
-    rest = local[span].mean(axis=0)
-    units = user_fapu(dict(zip(layout.feature_points, rest, strict=True)), fapu)
-    values = np.zeros((len(data), N_FAPS))
-    mask = np.zeros((len(data), N_FAPS), bool)
-    for col, row, axis, sign, unit in _plan(layout, pose):  # eq. 4.16, per axis
-        values[:, col] = sign * (local - rest)[:, row, axis] / units[unit]
-        mask[:, col] = True
-    if model is not None:
-        _fit(local_all, span, units, model, values=values, mask=mask)
-    _gaze(local, layout, span, values, mask)
+    span = neutral_span(neutral, len(data))
+    frame = head_frame(data, layout=layout, span=span, fapu=fapu)
+    values, mask = _face_faps(frame, layout, span, model)
+    pose = frame.pose
     if pose is not None:
-        for fap_id, angle in zip(_HEAD, euler_angles(pose.rotation), strict=True):
-            values[:, fap_id - 1] = angle / ANGLE_UNIT
-            mask[:, fap_id - 1] = True
+        angles = np.stack(euler_angles(pose.rotation), axis=1)
+        if isinstance(model, ObservationModel):  # the fit's learned error taken out
+            angles += pose_correction(model, (frame.landmarks - frame.rest)[..., :2],
+                                      frame.fapu)
+        values[:, [f - 1 for f in _HEAD]] = angles / ANGLE_UNIT
+        mask[:, [f - 1 for f in _HEAD]] = True
+    lips = (frame, layout) if close_lips and model is not None else None
     values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
-                           relations=relations)
-    return TrackedFaps(FapStream(rate, values, mask), units, pose, filled)
+                           relations=relations, lips=lips)
+    return TrackedFaps(FapStream(rate, values, mask), frame.fapu, pose, filled)
 
 
 def landmarks_to_faps(landmarks: np.ndarray, *, fps: float, **options: object) -> FapStream:

@@ -1,9 +1,11 @@
-"""The closed loop: the default head rendered from a known stream (speech, expressions,
-gaze, blinks, head turns up to 20 degrees), tracked with MediaPipe, compared curve by curve.
+"""The closed loop: the default head and the SOMA-X head rendered from a known stream
+(speech, expressions, gaze, blinks, head turns up to 20 degrees), tracked with MediaPipe,
+compared curve by curve with the learned observation model (the default).
 
-The thresholds are the figures this implementation reaches (benchmarks/tracking.py prints
-them all) minus a margin: they guard against regressions. They are below the issue's goal
-of 0.9 for the face FAPs; docs/performance-driven.md says where and why.
+The thresholds are the figures this implementation reaches on these 110 frames
+(benchmarks/tracking.py prints the whole clip) minus a margin of 0.05-0.1: they guard
+against regressions. docs/performance-driven.md lists which of the issue's goals of 0.9
+are met.
 """
 
 from __future__ import annotations
@@ -15,33 +17,77 @@ pytest.importorskip("mediapipe")
 pytestmark = [pytest.mark.render, pytest.mark.slow]
 
 import facelib  # noqa: E402
+from facelib.engine import default_face  # noqa: E402
 from facelib.tracking.closedloop import (  # noqa: E402
     closed_loop,
     closure_events,
+    closure_recall,
     event_recall,
+    false_closures,
+    lip_closures,
+    lip_gap,
     with_head_turns,
 )
 
+FLOORS = {3: 0.8, 6: 0.85, 7: 0.85, 12: 0.9, 13: 0.85, 19: 0.8, 20: 0.85, 23: 0.85, 24: 0.85}
+"""open_jaw, lip corners (stretch 6/7, raise 12/13), upper lids, eyeball yaw. On these 110
+frames the default head measures 0.88, 0.95/0.93, 0.98/0.94, 0.90/0.95, 0.97/0.97 and the
+SOMA-X head 0.88, 0.95/0.91, 0.95/0.94, 0.88/0.91, 0.92/0.94."""
+
 
 @pytest.fixture(scope="module")
-def loop():
-    hello = facelib.run_fdl("examples/hello/hello.fdl").faps
+def hello():
+    return facelib.run_fdl("examples/hello/hello.fdl").faps
+
+
+@pytest.fixture(scope="module")
+def loop(hello):
     return closed_loop(with_head_turns(hello, frames=110))
 
 
-def test_head_pose_comes_back(loop):
-    assert loop.correlation(49) > 0.95   # yaw, up to 20 degrees
-    assert loop.correlation(48) > 0.85   # pitch
-    assert loop.correlation(50) > 0.85   # roll
-    assert 0.8 < loop.gain(49) < 1.25
+@pytest.fixture(scope="module")
+def soma_loop(hello):
+    return closed_loop(with_head_turns(hello, frames=110), face=soma_face())
+
+
+def soma_face():
+    return facelib.setup_face("examples/heads/soma_head.ply",
+                              landmarks="examples/heads/soma_landmarks.json")
+
+
+def test_head_pose_comes_back(loop, soma_loop):
+    # the rigid fit plus its learned error: 0.996-0.998 on both heads (0.92 pitch, 0.94 roll
+    # and yaw gain 1.12 from the fit alone)
+    for found in (loop, soma_loop):
+        assert found.correlation(49) > 0.98   # yaw, up to 20 degrees
+        assert found.correlation(48) > 0.97   # pitch, 10
+        assert found.correlation(50) > 0.97   # roll, 8
+        assert 0.9 < found.gain(49) < 1.1
 
 
 def test_face_faps_follow_the_truth(loop):
-    # the lip corners' sideways FAPs 53/54 no longer move in hello (joy lifts the corners
-    # through the learned fields of issue 14), so they are not compared here
-    floors = {3: 0.65, 19: 0.5, 20: 0.6, 24: 0.6}
-    found = {fap_id: round(loop.correlation(fap_id), 3) for fap_id in floors}
-    assert all(found[k] > v for k, v in floors.items()), found
+    # the outer lip corners' FAPs 53/54 do not move in hello and 59/60 barely (under 50
+    # units), so the corners are compared on the inner-lip FAPs 6/7 and 12/13
+    found = {fap_id: round(loop.correlation(fap_id), 3) for fap_id in FLOORS}
+    assert all(found[k] > v for k, v in FLOORS.items()), found
+    assert 0.6 < loop.gain(3) < 1.2       # open_jaw's amplitude comes back (0.35 before)
+
+
+def test_the_learned_model_beats_the_rig_fit(loop):
+    rig = loop.remeasure(rig="default").stream.values
+    truth = loop.truth.values
+    for fap_id in (3, 6, 12, 19, 23):
+        before = np.corrcoef(truth[:, fap_id - 1], rig[:, fap_id - 1])[0, 1]
+        assert loop.correlation(fap_id) > before, fap_id
+
+
+def test_soma_head_follows_the_truth(soma_loop):
+    found = {fap_id: round(soma_loop.correlation(fap_id), 3) for fap_id in FLOORS}
+    assert all(found[k] > v for k, v in FLOORS.items()), found
+    assert soma_loop.correlation(49) > 0.95
+    for fap_id in (19, 20):
+        events = closure_events(soma_loop.truth.values[:, fap_id - 1], 600)
+        assert event_recall(events, soma_loop.tracked.stream.values[:, fap_id - 1]) >= 0.9
 
 
 def test_blinks_come_back(loop):
@@ -49,6 +95,28 @@ def test_blinks_come_back(loop):
         events = closure_events(loop.truth.values[:, fap_id - 1], 600)
         assert events
         assert event_recall(events, loop.tracked.stream.values[:, fap_id - 1]) >= 0.9
+
+
+@pytest.mark.parametrize("which", ["default", "soma"])
+def test_lip_closures_come_back(which, loop, soma_loop):
+    # p/b/m: the avatar's lips touch during the source's closures (gap under 0.1 MNS0 for
+    # at most 0.4 s) and part again between them. On these frames the default head's lips
+    # touch in 5 of 5 and part again in 3 of 5 (two quick closures in a row merge), with
+    # 2 false closures; the SOMA-X head's touch and part in 2 of 3 (1 of 3 without the
+    # closed mouth state), with 1 false closure
+    found, face = (loop, default_face()) if which == "default" else (soma_loop, soma_face())
+    truth_gap = lip_gap(face, found.truth)
+    events = lip_closures(truth_gap, found.truth.fps)
+    assert len(events) >= 3
+
+    def recall(stream, **options):
+        return closure_recall(events, lip_gap(face, stream), **options)
+
+    assert recall(found.tracked.stream) >= 0.6
+    assert recall(found.tracked.stream, truth_gap=truth_gap) >= 0.55
+    assert false_closures(truth_gap, lip_gap(face, found.tracked.stream)) <= 4
+    if which == "soma":
+        assert recall(found.tracked.stream) > recall(found.remeasure(close_lips=False).stream)
 
 
 def test_no_frame_lost_and_fapu_plausible(loop):

@@ -1,0 +1,219 @@
+"""An observation model learned by analysis by synthesis: FAPs read off the tracker's
+landmark motion by a linear estimator learned from renders.
+
+The default head is rendered with random FAP poses and head turns (a seeded training
+stream, ``tools/build_tracking_observation.py``), MediaPipe tracks the renders, and the
+landmarks are put in the neutral head's frame (rigid fit, :mod:`facelib.tracking.headframe`).
+Each frame gives ``d``: the ``x, y`` motion of all 478 landmarks from their neutral
+positions over the user's eye separation ``ES0``, and the FAPs that made it, each as a
+displacement ``f_k L_k / ES0`` (``L_k`` the FAP's unit length, :func:`fap_lengths`). A
+regression on the leading principal components of ``d`` (the components take the
+correlated jitter of neighbouring landmarks out) learns ``E``, ``(478 * 2, m)``, and
+tracking reads ``f_k = (d E)_k ES0 / L_k``, kept within the range seen in training.
+
+Why an estimator and not the inverse of a forward model: MediaPipe's landmarks on a face
+are not the mesh's vertices and do not move linearly with the FAPs (a linear forward model
+explains the training renders' jaw only to r = 0.89), and many FAPs move the same landmarks
+alike (inner and outer lip); solving the forward model by bounded least squares split the
+motion between them (open_jaw r = 0.72-0.78 on the closed loop), where the learned estimator
+carries the statistics of facelib's visemes and expressions (r = 0.88). Both sides are
+measured on the tracker's own landmarks in the user's FAPU, so the model carries over to
+other faces.
+
+The same regression learns the rigid pose fit's error (true minus fitted pitch, yaw and
+roll): expressions move the fit's stable points (a smile lifts the nostrils, which the fit
+alone reads as a nod of several degrees); tracking adds the estimate to the fitted angles
+(:func:`pose_correction`).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from facelib.atomic import atomic_path
+from facelib.checks import check_count
+from facelib.data import path as data_path
+from facelib.errors import DataError, ParameterError, TrackingError
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, fap_table
+from facelib.tracking.headframe import head_frame, neutral_span
+from facelib.tracking.layouts import landmark_layout
+from facelib.tracking.pose import euler_angles
+
+__all__ = ["MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
+           "learn_observation", "load_observation", "pose_correction", "save_observation",
+           "solve_observation"]
+
+MODEL_FAPS = (3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 16, 17, 19, 20, 21, 22, 23, 24, 25, 26,
+              31, 32, 33, 34, 35, 36, 37, 38, 41, 42, 51, 52, 53, 54, 55, 56, 57, 58, 59, 60,
+              61, 62)
+"""FAPs the packaged model learns: what facelib's visemes, expressions, lids and gaze move
+on the skin and eyes (tongue, head and ears are left out)."""
+_DATA = "tracking/observation_mediapipe.npz"
+
+
+@dataclass(frozen=True)
+class ObservationModel:
+    """A learned linear map from landmark motion to FAPs.
+
+    Attributes
+    ----------
+    faps: ``(m,) int64`` FAP ids.
+    estimator: ``(L, 2, m) float64``: FAP displacement (over ES0) per unit of each
+        landmark's ``x, y`` motion (over ES0) in the neutral head's frame.
+    bounds: ``(m, 2) float64`` lowest and highest FAP value (FAP units) seen in training,
+        widened by a tenth of the range.
+    pose: ``(L, 2, 3) float64`` or None: the error of the rigid pose fit (true minus fitted
+        pitch, yaw, roll, radians) per unit of landmark motion, learned alike: expressions
+        move the fit's stable points (a smile lifts the nostrils and the fit reads a nod).
+    pose_bounds: ``(3, 2) float64`` or None: the range of that error in training, widened
+        by a tenth.
+    """
+
+    faps: np.ndarray
+    estimator: np.ndarray
+    bounds: np.ndarray
+    pose: np.ndarray | None = None
+    pose_bounds: np.ndarray | None = None
+
+
+def fap_lengths(faps: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
+    """``(m,)`` length of one unit of each FAP in the units' length unit: its FAPU, and for
+    angles (``AU``, radians) the angle times the eye separation ``ES0``."""
+    table = fap_table()
+    es = fapu["ES"] * FAPU_SCALE
+    return np.array([ANGLE_UNIT * es if table[f - 1].fapu == "AU" else fapu[table[f - 1].fapu]
+                     for f in np.asarray(faps, np.int64)], np.float64)
+
+
+def _normalised(landmarks: np.ndarray, neutral: int | tuple[int, int]
+                ) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
+    """MediaPipe landmarks ``(n, 478, 3)`` -> displacements ``(n, 478, 2)`` over ES0 in the
+    neutral head frame, the user's FAPU and the fitted ``(n, 3)`` pitch, yaw, roll
+    (radians)."""
+    data = np.asarray(landmarks, np.float64)
+    layout = landmark_layout("mediapipe")
+    frame = head_frame(data, layout=layout, span=neutral_span(neutral, len(data)))
+    if frame.pose is None:
+        raise TrackingError("the observation model needs a rigid head fit")
+    es = frame.fapu["ES"] * FAPU_SCALE
+    angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
+    return (frame.landmarks - frame.rest)[..., :2] / es, frame.fapu, angles
+
+
+def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
+                      neutral: int | tuple[int, int] = 0,
+                      faps: tuple[int, ...] = MODEL_FAPS,
+                      components: int = 60) -> ObservationModel:
+    """Learn the model from ``(n, 478, 3)`` MediaPipe landmarks (image coordinates, no
+    missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
+
+    ``neutral``: the neutral frame(s); ``components``: principal components of the landmark
+    motion the regression uses (fewer than frames).
+    """
+    moved, fapu, fitted = _normalised(landmarks, neutral)
+    n, n_land = moved.shape[:2]
+    components = check_count("components", components, low=1)
+    if components > n - 2:
+        raise ParameterError(f"{components} components need more than {components + 1} "
+                             f"frames, got {n}")
+    ids = np.asarray(faps, np.int64)
+    truth = np.asarray(values, np.float64)[:, ids - 1]
+    target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
+    pose_error = np.asarray(values, np.float64)[:, 47:50] * ANGLE_UNIT - fitted
+    target = np.hstack([target, pose_error])
+    flat = moved.reshape(n, -1)
+    centre = flat.mean(axis=0)
+    basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:components]  # (k, 2L)
+    design = np.hstack([(flat - centre) @ basis.T, np.ones((n, 1))])
+    coef = np.linalg.lstsq(design, target, rcond=None)[0][:components]  # (k, m + 3)
+    estimator = (basis.T @ coef).reshape(n_land, 2, len(ids) + 3)
+    return ObservationModel(ids, estimator[..., :-3], _range(truth), estimator[..., -3:],
+                            _range(pose_error))
+
+
+def _range(values: np.ndarray) -> np.ndarray:
+    """``(m, 2)`` lowest and highest of each column of ``(n, m)`` values, widened by a tenth
+    of the range."""
+    span = np.ptp(values, axis=0)
+    return np.stack([values.min(axis=0) - 0.1 * span, values.max(axis=0) + 0.1 * span], axis=1)
+
+
+def solve_observation(model: ObservationModel, displacements: np.ndarray,
+                      fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, m) float64`` FAP values of ``model.faps`` from ``(n, L, 2)`` landmark
+    displacements (neutral head frame, the unit of ``fapu``), each kept within
+    ``model.bounds``; 0 for a frame with no motion."""
+    es = fapu["ES"] * FAPU_SCALE
+    moved = np.asarray(displacements, np.float64).reshape(len(displacements), -1) / es
+    found = moved @ model.estimator.reshape(moved.shape[1], -1)
+    found *= es / fap_lengths(model.faps, fapu)
+    return np.clip(found, model.bounds[:, 0], model.bounds[:, 1])
+
+
+def pose_correction(model: ObservationModel, displacements: np.ndarray,
+                    fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, 3) float64`` correction (radians) to add to the fitted pitch, yaw and roll, from
+    ``(n, L, 2)`` landmark displacements (neutral head frame, the unit of ``fapu``), within
+    ``model.pose_bounds``; zeros for a model without one."""
+    n = len(displacements)
+    if model.pose is None or model.pose_bounds is None:
+        return np.zeros((n, 3))
+    moved = np.asarray(displacements, np.float64).reshape(n, -1) / (fapu["ES"] * FAPU_SCALE)
+    found = moved @ model.pose.reshape(moved.shape[1], 3)
+    return np.clip(found, model.pose_bounds[:, 0], model.pose_bounds[:, 1])
+
+
+def save_observation(model: ObservationModel, path: str | os.PathLike[str]) -> Path:
+    """Write ``model`` as a compressed ``.npz`` (float32), atomically."""
+    buffer = io.BytesIO()
+    pose = np.zeros((0, 2, 3)) if model.pose is None else model.pose
+    pose_bounds = np.zeros((0, 2)) if model.pose_bounds is None else model.pose_bounds
+    np.savez_compressed(buffer, faps=model.faps.astype(np.int16),
+                        estimator=model.estimator.astype(np.float32),
+                        bounds=model.bounds.astype(np.float32),
+                        pose=pose.astype(np.float32), pose_bounds=pose_bounds.astype(np.float32))
+    with atomic_path(path) as temp:
+        temp.write_bytes(buffer.getvalue())
+    return Path(path)
+
+
+def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> ObservationModel:
+    """Read a model written by :func:`save_observation` (the pose arrays may be absent or
+    empty); DataError if it is malformed."""
+    where = str(source) if isinstance(source, (str, os.PathLike)) else _DATA
+    try:
+        with np.load(source, allow_pickle=False) as raw:
+            arrays = {k: np.array(raw[k], np.float64) for k in ("faps", "estimator", "bounds")}
+            for key in ("pose", "pose_bounds"):
+                if key in raw.files and raw[key].size:
+                    arrays[key] = np.array(raw[key], np.float64)
+    except (OSError, KeyError, ValueError) as exc:
+        raise DataError(f"not an observation model ({exc})", path=where) from exc
+    m = len(arrays["faps"]) if arrays["faps"].ndim == 1 else -1
+    shape = arrays["estimator"].shape
+    pose_ok = len(shape) == 3 and (("pose" in arrays) == ("pose_bounds" in arrays)
+                                   and arrays.get("pose", np.zeros((shape[0], 2, 3))).shape
+                                   == (shape[0], 2, 3)
+                                   and arrays.get("pose_bounds", np.zeros((3, 2))).shape
+                                   == (3, 2))
+    if m < 0 or not pose_ok or shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
+        raise DataError("observation model arrays disagree in shape", path=where)
+    for value in arrays.values():
+        value.flags.writeable = False
+    return ObservationModel(arrays["faps"].astype(np.int64), arrays["estimator"],
+                            arrays["bounds"], arrays.get("pose"), arrays.get("pose_bounds"))
+
+
+@cache
+def default_observation() -> ObservationModel:
+    """The packaged model: MediaPipe's 478 landmarks on the default head at 640x480
+    (``facelib/data/tracking/observation_mediapipe.npz``)."""
+    with data_path(_DATA).open("rb") as f:
+        return load_observation(io.BytesIO(f.read()))

@@ -1,0 +1,76 @@
+"""The closed mouth state of p/b/m (facelib.tracking.lipclosure): the detector's thresholds,
+the lip FAPs it sets, and the inner-lip aperture on model-made landmarks of the default
+head (its MediaPipe-embedded vertices projected like a 640x480 camera)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facelib.engine import default_face
+from facelib.mpeg4 import N_FAPS, FapStream, fap
+from facelib.tracking.embedding import default_head_embedding
+from facelib.tracking.headframe import head_frame
+from facelib.tracking.layouts import landmark_layout
+from facelib.tracking.lipclosure import (
+    close_lips,
+    closed_frames,
+    inner_lip_aperture,
+    learn_threshold,
+    lip_closure,
+)
+
+PIXELS_PER_METRE = 1500.0
+
+
+def camera(values: np.ndarray) -> np.ndarray:
+    """``(n, 478, 3)`` image coordinates of the default head's embedded landmarks."""
+    moved = default_face().deform(FapStream(25.0, values))[:, default_head_embedding()]
+    return np.asarray(moved, np.float64) * PIXELS_PER_METRE * [1, -1, -1] + [320, 240, 0]
+
+
+def test_packaged_rule():
+    rule = lip_closure()
+    assert len(rule.upper) == len(rule.lower) == 5
+    assert (np.concatenate([rule.upper, rule.lower]) < 468).all()
+    assert 0.0 < rule.close_below <= rule.open_above < 0.05
+    assert rule.closed_gap < 0
+
+
+def test_hysteresis():
+    aperture = np.array([0.1, 0.01, 0.03, 0.05, 0.03, 0.01])
+    assert closed_frames(aperture, close_below=0.02, open_above=0.04).tolist() == [
+        False, True, True, False, False, True]
+    assert closed_frames(aperture, close_below=0.02, open_above=0.02).tolist() == [
+        False, True, False, False, False, True]
+
+
+def test_close_lips_lowers_the_separation_only_where_closed():
+    rule = lip_closure()
+    values = np.zeros((3, N_FAPS))
+    values[:, 2] = 200.0                       # open_jaw
+    values[2, [3, 4]] = 400.0                  # already pressed
+    out = close_lips(values, np.array([False, True, True]), rule)
+    separation = rule.jaw_gain * out[:, 2] - out[:, 3] - out[:, 4]
+    np.testing.assert_allclose(out[0], values[0])
+    np.testing.assert_allclose(separation[1], rule.closed_gap)
+    np.testing.assert_allclose(out[2], values[2])
+    np.testing.assert_allclose(out[:, 2], 200.0)  # open_jaw is left alone
+    assert out[1, 3] == out[1, 4] > 0
+    assert out[1, 7] == rule.neighbours[8] * out[1, 3]
+
+
+def test_learn_threshold_is_the_quantile_of_open_frames():
+    aperture = np.concatenate([np.zeros(50), np.linspace(0.0, 0.1, 101)])
+    is_open = np.arange(151) >= 50
+    assert abs(learn_threshold(aperture, is_open, false_closed=0.2) - 0.02) < 1e-12
+
+
+def test_aperture_tells_pressed_from_open_lips():
+    values = np.zeros((6, N_FAPS), np.float32)
+    values[4, fap("open_jaw").index] = 300       # jaw open
+    for name, value in (("open_jaw", 12), ("lower_t_midlip", 70), ("raise_b_midlip", 90)):
+        values[5, fap(name).index] = value       # the p/b/m viseme's press
+    frame = head_frame(camera(values), layout=landmark_layout("mediapipe"), span=slice(0, 4))
+    aperture = inner_lip_aperture(frame, lip_closure())
+    assert aperture[4] > 0.1
+    assert aperture[5] < lip_closure().close_below

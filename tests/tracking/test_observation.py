@@ -1,0 +1,143 @@
+"""The learned observation model on exact, model-made landmark motion (no rendering): the
+default head deformed by known FAPs, its MediaPipe-embedded vertices projected like a
+640x480 camera, learned on one random stream and read back on another."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facelib.engine import default_face
+from facelib.errors import DataError, ParameterError
+from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
+from facelib.tracking.embedding import default_head_embedding
+from facelib.tracking.faps import measure_faps
+from facelib.tracking.observation import (
+    MODEL_FAPS,
+    default_observation,
+    learn_observation,
+    load_observation,
+    save_observation,
+    solve_observation,
+)
+
+FAPS = (3, 5, 12, 13, 19, 20, 31, 32, 23, 24)
+PIXELS_PER_METRE = 1500.0
+
+
+def random_stream(n: int, seed: int, *, turns: bool = True) -> np.ndarray:
+    """``(n, 84)`` FAP values: FAPS at random, head turns up to 15 degrees, 4 neutral
+    frames first."""
+    rng = np.random.default_rng(seed)
+    values = np.zeros((n, N_FAPS), np.float32)
+    reach = {3: 500, 5: 200, 12: 400, 13: 400, 19: 900, 20: 900, 31: 150, 32: 150,
+             23: np.radians(25) / ANGLE_UNIT, 24: np.radians(25) / ANGLE_UNIT}
+    for fap_id in FAPS:
+        low = 0.0 if fap_id == 3 else -1.0
+        values[4:, fap_id - 1] = rng.uniform(low, 1.0, n - 4) * reach[fap_id]
+    if turns:
+        for fap_id, degrees in ((48, 8), (49, 15), (50, 6)):
+            values[4:, fap_id - 1] = np.radians(rng.uniform(-degrees, degrees, n - 4)) / ANGLE_UNIT
+    return values
+
+
+def camera(values: np.ndarray) -> np.ndarray:
+    """``(n, 478, 3)`` image coordinates of the default head's embedded landmarks."""
+    face = default_face()
+    moved = face.deform(FapStream(25.0, values))[:, default_head_embedding()]
+    return np.asarray(moved, np.float64) * PIXELS_PER_METRE * [1, -1, -1] + [320, 240, 0]
+
+
+@pytest.fixture(scope="module")
+def learned():
+    values = random_stream(400, seed=1)
+    return learn_observation(camera(values), values, neutral=(0, 4), faps=FAPS,
+                             components=40)
+
+
+def test_model_reads_back_a_fresh_stream(learned):
+    values = random_stream(120, seed=2)
+    result = measure_faps(camera(values), fps=25, neutral=(0, 4), rig=learned, smooth=False,
+                          relations=False)
+    for fap_id in FAPS:
+        truth, found = values[4:, fap_id - 1], result.stream.values[4:, fap_id - 1]
+        assert np.corrcoef(truth, found)[0, 1] > 0.97, fap_id
+        gain = np.polyfit(truth, found, 1)[0]
+        assert 0.85 < gain < 1.15, (fap_id, gain)
+    yaw = result.stream.values[4:, 48] * ANGLE_UNIT
+    assert np.abs(yaw - values[4:, 48] * ANGLE_UNIT).max() < np.radians(1.0)
+
+
+def test_neutral_reads_zero_and_size_does_not_matter(learned):
+    values = random_stream(40, seed=3)
+    points = camera(values)
+    near = (points - [320, 240, 0]) * 1.7 + [300, 250, 0]   # closer to the camera, shifted
+    a = measure_faps(points, fps=25, neutral=(0, 4), rig=learned, smooth=False).stream
+    b = measure_faps(near, fps=25, neutral=(0, 4), rig=learned, smooth=False).stream
+    cols = np.asarray(FAPS) - 1
+    np.testing.assert_allclose(a.values[:4, cols], 0.0, atol=1e-6)
+    np.testing.assert_allclose(b.values[:, cols], a.values[:, cols], rtol=1e-4, atol=1e-3)
+
+
+def test_solve_keeps_the_training_range(learned):
+    big = np.full((1, 478, 2), 1e3)
+    found = solve_observation(learned, big, {"ES": 0.1, "ENS": 0.1, "MNS": 0.05,
+                                             "MW": 0.05, "IRISD": 0.01, "AU": 1e-5})
+    assert (found >= learned.bounds[:, 0] - 1e-9).all()
+    assert (found <= learned.bounds[:, 1] + 1e-9).all()
+
+
+def test_save_and_load_round_trip(learned, tmp_path):
+    path = save_observation(learned, tmp_path / "model.npz")
+    back = load_observation(path)
+    np.testing.assert_array_equal(back.faps, learned.faps)
+    np.testing.assert_allclose(back.estimator, learned.estimator, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(back.bounds, learned.bounds, rtol=1e-6)
+    assert back.pose is not None and learned.pose is not None
+    np.testing.assert_allclose(back.pose, learned.pose, rtol=1e-6, atol=1e-9)
+    (tmp_path / "bad.npz").write_bytes(b"not an npz")
+    with pytest.raises(DataError):
+        load_observation(tmp_path / "bad.npz")
+
+
+def test_packaged_model():
+    model = default_observation()
+    assert tuple(model.faps) == MODEL_FAPS
+    assert model.estimator.shape == (478, 2, len(MODEL_FAPS))
+    assert np.isfinite(model.estimator).all()
+    assert (model.bounds[:, 0] < model.bounds[:, 1]).all()
+    assert model.pose is not None and model.pose.shape == (478, 2, 3)
+    assert model.pose_bounds is not None
+    assert (np.abs(model.pose_bounds) < np.radians(20)).all()   # corrections of a few degrees
+
+
+def test_pose_correction_learns_a_fit_error():
+    # the rigid fit's stable points are moved by an expression (the nostrils lift with
+    # FAP 61/62 here), so the fit reads a nod: the model learns it from the landmark motion
+    rng = np.random.default_rng(5)
+    values = np.zeros((300, N_FAPS), np.float32)
+    values[4:, 60] = values[4:, 61] = rng.uniform(0, 300, 296)      # stretch the nose wings
+    values[4:, 2] = rng.uniform(0, 400, 296)                        # open_jaw
+    values[4:, 47] = np.radians(rng.uniform(-8, 8, 296)) / ANGLE_UNIT   # pitch
+    points = camera(values)
+    model = learn_observation(points, values, neutral=(0, 4), faps=(3, 61, 62), components=20)
+    plain = measure_faps(points, fps=25, neutral=(0, 4), rig=learned_without_pose(model),
+                         smooth=False).stream.values[4:, 47]
+    fixed = measure_faps(points, fps=25, neutral=(0, 4), rig=model,
+                         smooth=False).stream.values[4:, 47]
+    before = np.abs(plain - values[4:, 47]).mean() * ANGLE_UNIT
+    after = np.abs(fixed - values[4:, 47]).mean() * ANGLE_UNIT
+    assert before > np.radians(0.1)      # the fit alone is fooled (0.23 degrees)
+    assert after < 0.1 * before
+
+
+def learned_without_pose(model):
+    return type(model)(model.faps, model.estimator, model.bounds)
+
+
+def test_observed_needs_mediapipe_in_3d():
+    with pytest.raises(ParameterError):
+        measure_faps(np.zeros((3, 478, 2)), fps=25, rig="observed")
+    with pytest.raises(ParameterError):
+        learn_observation(camera(random_stream(6, seed=4)), random_stream(6, seed=4),
+                          neutral=(0, 4), components=10)
