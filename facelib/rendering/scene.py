@@ -63,8 +63,8 @@ class Look:
 
     ``shading``: ``wrap`` and ``specular`` of the face shader; ``occlusion`` and
     ``occlusion_power``: how the baked ambient occlusion darkens colours (a part's material
-    may set its own ``occlusion_power``); ``supersample``: the factor of the fallback
-    anti-aliasing.
+    may set its own ``occlusion_strength`` and ``occlusion_power``); ``supersample``: the
+    factor of the fallback anti-aliasing.
     """
 
     parts: Mapping[str, Mapping[str, float]]
@@ -293,13 +293,25 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
-def _occlusion_factor(n: int, occlusion: Any, strength: float,
+def _part_occlusion(look: Look, pieces: Sequence[Any], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(n,)`` occlusion strength and power of each vertex: the look's, or its part's own
+    (``occlusion_strength``, ``occlusion_power`` in the part's material)."""
+    strength = np.full(n, look.occlusion, np.float32)
+    power = np.full(n, look.occlusion_power, np.float32)
+    for piece in pieces:
+        spec = look.material(piece.name)
+        strength[piece.vertex_ids] = float(spec.get("occlusion_strength", look.occlusion))
+        power[piece.vertex_ids] = float(spec.get("occlusion_power", look.occlusion_power))
+    return strength, power
+
+
+def _occlusion_factor(n: int, occlusion: Any, strength: np.ndarray | float,
                       power: np.ndarray | float = 1.0) -> np.ndarray:
     """``(n,) float32`` how much light baked ambient occlusion lets through to each vertex.
 
     ``occlusion`` is ``(n,)`` in [0, 1] (1 = open sky, ``Face.vertex_ao``) or None (all
-    1); the factor is ``1 - strength * (1 - occlusion ** power)`` (``power`` a number or
-    ``(n,)``).
+    1); the factor is ``1 - strength * (1 - occlusion ** power)`` (``strength`` and
+    ``power`` numbers or ``(n,)``).
     """
     if occlusion is None:
         return np.ones(n, np.float32)
@@ -456,16 +468,12 @@ class FaceRenderer:
         self._triangles = triangles
         self._normal_op = normal_operator(self.n_vertices, triangles)
         self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
-        default_power = self.look.occlusion_power
-        power = np.full(len(vertices), default_power, np.float32)
-        for piece in self._pieces:  # a part may set its own (the eyes)
-            spec = self.look.material(piece.name)
-            power[piece.vertex_ids] = float(spec.get("occlusion_power", default_power))
+        strength, power = _part_occlusion(self.look, self._pieces, len(vertices))
         # the occlusion darkens the albedo, and rides in the colour's alpha for the face
         # shader to dim the highlights too (no gloss deep in the mouth); pyrender blends
         # nothing with it (its blend function is ONE, ZERO for opaque materials)
         factor = _occlusion_factor(len(colors), getattr(face, "vertex_ao", None),
-                                   self.look.occlusion, power)
+                                   strength, power)
         linear = _srgb_to_linear(colors) * factor[:, None]
         self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
                         for p in self._pieces]
