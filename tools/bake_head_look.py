@@ -44,11 +44,13 @@ DEPTH_BIAS = 0.0006  # ... and counts as lit within this distance behind the dep
 SMOOTHING = 2  # rounds of averaging each vertex's occlusion with its neighbours' (half)
 POSES = {"neutral": {}, "open jaw": {"open_jaw": 700.0}}  # FAP values (FAP units)
 # Parts inside the mouth see the sky only through the opening (occlusion 0.0-0.2), which
-# would paint them black; they keep their occlusion relative to their most open vertices
-# (the front teeth, the tongue's tip), so they darken toward the back yet still read
-# against the cavity, which stays dark. The power steepens the fall toward the back.
+# would paint them black; they keep their occlusion relative to the most open vertices of
+# their front half (the front teeth, the tongue's blade), so they darken toward the back
+# yet still read against the cavity, which stays dark. The power steepens that fall.
 RELATIVE_PARTS = ("teeth_upper", "teeth_lower", "tongue")
-RELATIVE_PERCENTILE, RELATIVE_POWER = 98.0, 1.5
+RELATIVE_PERCENTILE = 98.0
+# the teeth fall off faster: only the front teeth catch the light, the molars stay dim
+RELATIVE_POWER = {"teeth_upper": 2.5, "teeth_lower": 2.5, "tongue": 1.5}
 # The tongue leaves the mouth (tongue out, FAP 43-44): its top, deep under the palate at
 # rest, must not turn black outside, so it keeps at least this much.
 RELATIVE_FLOOR = {"tongue": 0.3}
@@ -211,9 +213,12 @@ def occlusion(face) -> np.ndarray:
     ao = np.clip(_smooth(best, np.asarray(face.triangles), SMOOTHING), 0.0, 1.0)
     for name in RELATIVE_PARTS:
         ids = face.parts[name].vertex_ids
-        top = max(float(np.percentile(ao[ids], RELATIVE_PERCENTILE)), 1e-3)
+        # judged on the front half (the part's root may poke out of the cavity's floor,
+        # unseen, into the open neck, where it sees the sky)
+        front = ids[face.vertices[ids, 2] >= np.median(face.vertices[ids, 2])]
+        top = max(float(np.percentile(ao[front], RELATIVE_PERCENTILE)), 1e-3)
         floor = RELATIVE_FLOOR.get(name, 0.0)
-        ao[ids] = floor + (1.0 - floor) * np.clip(ao[ids] / top, 0.0, 1.0) ** RELATIVE_POWER
+        ao[ids] = floor + (1.0 - floor) * np.clip(ao[ids] / top, 0.0, 1.0) ** RELATIVE_POWER[name]
     return ao
 
 

@@ -58,7 +58,16 @@ SKIN = (0.87, 0.68, 0.57)
 LIP = (0.74, 0.40, 0.40)
 MOUTH = (0.42, 0.16, 0.17)
 LIP_SEAL, LIP_BAND = 0.0008, 0.004  # closing the resting lips (metres)
-TONGUE_DROP_DEG, TONGUE_BACK = 6.0, 0.05  # lowering the tongue (degrees, decimetres)
+# lowering the tongue: turned front-down (degrees), drawn back (decimetres), and its body
+# lowered: (distance in front of the root, drop), both decimetres, interpolated. The root
+# stays in the floor of the mouth; the back of the body, which filled the open mouth,
+# drops most; the tip, already behind the lower incisors, stays for the tongue visemes.
+TONGUE_DROP_DEG, TONGUE_BACK = 6.0, 0.05
+TONGUE_DOWN = ((0.0, 0.0), (0.25, 0.06), (0.5, 0.06), (0.64, 0.0))
+# the lower teeth raised and drawn back (decimetres) from MakeHuman's edge-to-edge bite into
+# a normal one: their edges rest behind the upper incisors, a few millimetres above the
+# upper edges, so a wide-open jaw shows them over the lower lip as in real faces
+LOWER_TEETH_UP, LOWER_TEETH_BACK = 0.025, 0.02
 SCLERA = (0.93, 0.91, 0.88)  # off-white; the lids' shadow on it is baked occlusion
 IRIS = (0.30, 0.45, 0.55)
 IRIS_IN = (0.42, 0.50, 0.46)  # the collarette round the pupil: lighter, a little green
@@ -68,8 +77,8 @@ IRIS_IN = (0.42, 0.50, 0.46)  # the collarette round the pupil: lighter, a littl
 LID_SHADOW = (0.0, 0.36, 0.62)
 IRIS_RIM = (0.12, 0.18, 0.22)
 PUPIL = (0.02, 0.02, 0.02)
-TEETH = (0.93, 0.91, 0.84)
-TONGUE = (0.68, 0.30, 0.34)  # redder and darker than the lips, so it reads apart
+TEETH = (0.89, 0.84, 0.74)  # ivory, not paper white
+TONGUE = (0.62, 0.22, 0.25)  # redder and darker than the lips, so it reads apart
 # painted eyebrows: colour, half-heights (metres) at the inner, middle and outer brow points,
 # how far past the outer point the tail runs, and the soft edge
 BROW = (0.30, 0.20, 0.15)
@@ -238,14 +247,17 @@ def rest_tongue(verts: np.ndarray, root: np.ndarray) -> np.ndarray:
 
     MakeHuman's tongue presses its tip against the back of the upper incisors, level with
     their edges, so any jaw opening shows a wall of tongue. A tongue at rest lies behind
-    the lower incisors: turn it front-down about its root (``joint-tongue-1``) and draw it
-    back a little (units: decimetres, the base mesh's).
+    the lower incisors, its back low enough that an open mouth shows the dark cavity above
+    it: turn it front-down about its root (``joint-tongue-1``), draw it back a little and
+    lower its body between root and tip (units: decimetres, the base mesh's).
     """
     angle = np.radians(TONGUE_DROP_DEG)
     c, s = np.cos(angle), np.sin(angle)
     rel = verts - root
     y = rel[:, 1] * c - rel[:, 2] * s
     z = rel[:, 1] * s + rel[:, 2] * c
+    at, drop = np.array(TONGUE_DOWN).T
+    y = y - np.interp(z, at, drop)
     return root + np.stack([rel[:, 0], y, z - TONGUE_BACK], 1)
 
 
@@ -319,6 +331,7 @@ def build(wheel_path: Path) -> None:
 
     teeth_u, teeth_l, tongue = helper("upper-teeth"), helper("lower-teeth"), helper("tongue")
     tongue = (rest_tongue(tongue[0], joint["tongue-1"]), tongue[1])
+    teeth_l = (teeth_l[0] + [0.0, LOWER_TEETH_UP, -LOWER_TEETH_BACK], teeth_l[1])
 
     parts_src = [
         ("skin", skin_v, skin_t, None),

@@ -63,8 +63,8 @@ class Look:
 
     ``shading``: ``wrap`` and ``specular`` of the face shader; ``occlusion`` and
     ``occlusion_power``: how the baked ambient occlusion darkens colours (a part's material
-    may set its own ``occlusion_power``); ``supersample``: the factor of the fallback
-    anti-aliasing.
+    may set its own ``occlusion_strength`` and ``occlusion_power``); ``supersample``: the
+    factor of the fallback anti-aliasing.
     """
 
     parts: Mapping[str, Mapping[str, float]]
@@ -293,22 +293,32 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
-def _occluded(linear: np.ndarray, occlusion: Any, strength: float,
-              power: np.ndarray | float = 1.0) -> np.ndarray:
-    """Linear colours ``(V, 3)`` darkened by baked ambient occlusion.
+def _part_occlusion(look: Look, pieces: Sequence[Any], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(n,)`` occlusion strength and power of each vertex: the look's, or its part's own
+    (``occlusion_strength``, ``occlusion_power`` in the part's material)."""
+    strength = np.full(n, look.occlusion, np.float32)
+    power = np.full(n, look.occlusion_power, np.float32)
+    for piece in pieces:
+        spec = look.material(piece.name)
+        strength[piece.vertex_ids] = float(spec.get("occlusion_strength", look.occlusion))
+        power[piece.vertex_ids] = float(spec.get("occlusion_power", look.occlusion_power))
+    return strength, power
 
-    ``occlusion`` is ``(V,)`` in [0, 1] (1 = open sky, ``Face.vertex_ao``) or None (no
-    darkening); each colour is multiplied by ``1 - strength * (1 - occlusion ** power)``
-    (``power`` a number or ``(V,)``).
+
+def _occlusion_factor(n: int, occlusion: Any, strength: np.ndarray | float,
+                      power: np.ndarray | float = 1.0) -> np.ndarray:
+    """``(n,) float32`` how much light baked ambient occlusion lets through to each vertex.
+
+    ``occlusion`` is ``(n,)`` in [0, 1] (1 = open sky, ``Face.vertex_ao``) or None (all
+    1); the factor is ``1 - strength * (1 - occlusion ** power)`` (``strength`` and
+    ``power`` numbers or ``(n,)``).
     """
     if occlusion is None:
-        return linear
+        return np.ones(n, np.float32)
     occlusion = np.asarray(occlusion, np.float32)
-    if occlusion.shape != (len(linear),):
-        raise FaceModelError(f"face vertex_ao must have shape ({len(linear)},), "
-                             f"got {occlusion.shape}")
-    factor = 1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0) ** power)
-    return (linear * factor[:, None]).astype(np.float32)
+    if occlusion.shape != (n,):
+        raise FaceModelError(f"face vertex_ao must have shape ({n},), got {occlusion.shape}")
+    return (1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0) ** power)).astype(np.float32)
 
 
 def _face_arrays(face: Deformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -458,17 +468,15 @@ class FaceRenderer:
         self._triangles = triangles
         self._normal_op = normal_operator(self.n_vertices, triangles)
         self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
-        default_power = self.look.occlusion_power
-        power = np.full(len(vertices), default_power, np.float32)
-        for piece in self._pieces:  # a part may set its own (the eyes)
-            spec = self.look.material(piece.name)
-            power[piece.vertex_ids] = float(spec.get("occlusion_power", default_power))
-        linear = _occluded(_srgb_to_linear(colors), getattr(face, "vertex_ao", None),
-                           self.look.occlusion, power)
-        self._colors = [
-            np.hstack([linear[p.vertex_ids], np.ones((len(p.vertex_ids), 1), np.float32)])
-            for p in self._pieces
-        ]
+        strength, power = _part_occlusion(self.look, self._pieces, len(vertices))
+        # the occlusion darkens the albedo, and rides in the colour's alpha for the face
+        # shader to dim the highlights too (no gloss deep in the mouth); pyrender blends
+        # nothing with it (its blend function is ONE, ZERO for opaque materials)
+        factor = _occlusion_factor(len(colors), getattr(face, "vertex_ao", None),
+                                   strength, power)
+        linear = _srgb_to_linear(colors) * factor[:, None]
+        self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
+                        for p in self._pieces]
         self._materials = [self._material(p.name) for p in self._pieces]
         self._interleaved = [np.empty((len(c), 10), np.float32) for c in self._colors]
         for buf, color in zip(self._interleaved, self._colors, strict=True):

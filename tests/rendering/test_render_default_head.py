@@ -199,3 +199,49 @@ def test_lashes_darken_the_lid_margin(closure, fap_frame):  # type: ignore[no-un
     assert darker.mean() > 0.12  # many dark strands, not a tint
     assert not darker.all(axis=1).any()  # skin between the strands: not a black band
     assert np.abs(images[0][:20] - images[1][:20]).max() < 1  # the brow area is untouched
+
+
+@pytest.mark.parametrize("pose", ["surprise", "aa"])
+def test_open_mouth_shows_teeth_a_dark_cavity_and_a_darker_tongue(pose):
+    """Issue 14 (look): looking into the open mouth along its midline, from the upper lip
+    down: the upper teeth (ivory, shaded, not paper white), a dark cavity band above the
+    tongue, the tongue (red, clearly darker than the lips), the lower incisors' edges, then
+    the lower lip."""
+    from facelib.expressions import default_library
+    from facelib.visemes import viseme_targets
+    from facelib.visemes.tables import viseme_id
+
+    face = engine.load_face(None)
+    fp = face.feature_points
+    values = (viseme_targets()[viseme_id("aa")] if pose == "aa"
+              else default_library().get(pose).values)
+    moved = face.deform_frame(values)
+    mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "9.15", "2.1")]]
+    with FaceRenderer(face, width=480, height=360, framing=mouth) as renderer:
+        image = renderer.frame(moved).astype(int)
+        (ux, uy), (lx, ly), (_, oy) = renderer.project(moved[[fp["2.2"], fp["2.3"], fp["8.2"]]])
+    cx = int((ux + lx) / 2 + 0.5)
+    column = image[int(uy) : int(ly) + 1, cx - 3 : cx + 4].mean(1)  # (rows, 3), top down
+    lip = image[int((ly + oy) / 2) - 2 : int((ly + oy) / 2) + 3, cx - 3 : cx + 4]
+    lip = lip.reshape(-1, 3).mean(0)
+    red, green, blue = column.T
+    teeth = (column.min(1) > 140) & (red - blue < 60)
+    dark = column.max(1) < 60
+    tongue = (red > green + 40) & (red < 170)
+    rows = np.arange(len(column))
+    upper_teeth = teeth & (rows < np.flatnonzero(dark)[0])
+    lower_teeth = teeth & (rows > np.flatnonzero(tongue)[0])
+    # (the old head: a dark notch of a fifth of the opening over a wall of tongue, no
+    # lower teeth, teeth at 251 grey levels, the tongue 160 levels from the lips)
+    assert dark.sum() > 0.35 * len(column) and tongue.sum() >= 5
+    # the dark cavity lies above the tongue, the lower incisors below it
+    assert np.flatnonzero(dark)[-1] < np.flatnonzero(tongue)[0]
+    assert lower_teeth.sum() >= 3
+    # ivory with some shading, not a flat pure-white strip
+    assert upper_teeth.sum() >= 3
+    assert column[upper_teeth].max() < 245
+    assert (red - blue)[upper_teeth].min() > 20
+    # the tongue reads against the lips: darker, and far from their colour
+    tongue_colour = column[tongue].mean(0)
+    assert tongue_colour.sum() < lip.sum() - 180
+    assert np.abs(tongue_colour - lip).sum() > 180

@@ -185,3 +185,28 @@ def test_bad_occlusion_and_antialias_arguments(synthetic_face):
         FaceRenderer(Occluded(synthetic_face, np.ones(3)), width=32, height=32)
     with pytest.raises(ParameterError, match="antialias must be one of"):
         FaceRenderer(synthetic_face, width=32, height=32, antialias="fxaa")  # type: ignore[arg-type]
+
+
+def test_occlusion_dims_the_highlights_and_a_part_may_set_its_strength(synthetic_face):
+    """A black, glossy sphere shows only its highlights: the baked occlusion dims them by
+    the same factor as the colour (no glints deep in the mouth), and a part's own
+    occlusion_strength (the teeth's) replaces the look's."""
+    class Painted:
+        def __init__(self, face, ao):
+            self.vertices, self.triangles, self.parts = face.vertices, face.triangles, face.parts
+            self.vertex_colors = np.zeros_like(face.vertices)
+            self.vertex_ao = np.full(len(face.vertices), ao, np.float32)
+
+    glossy = {"roughness": 0.6, "metallic": 0.0, "occlusion_power": 1.0}
+    look = dataclasses.replace(load_look(), ambient=(0.0, 0.0, 0.0), occlusion=0.5,
+                               shading={"wrap": 0.0, "specular": 0.2})
+    peaks = []
+    for ao, strength in ((1.0, {}), (0.0, {}), (0.0, {"occlusion_strength": 1.0})):
+        shiny = dataclasses.replace(look, parts={"default": {**glossy, **strength}})
+        with FaceRenderer(Painted(synthetic_face, ao), width=120, height=120, framing="head",
+                          look=shiny, background=(0.0, 0.0, 0.0)) as renderer:
+            peaks.append(float(_luminance(renderer.frame(synthetic_face.vertices)).max()))
+    assert 120 < peaks[0] < 250  # unsaturated
+    # half the light: 0.5 ** (1 / 2.2) = 0.73 of the sRGB level
+    assert peaks[1] == pytest.approx(0.73 * peaks[0], abs=8)
+    assert peaks[2] < 3

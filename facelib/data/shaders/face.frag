@@ -9,7 +9,9 @@
 //   specular = F0 * (s + 8) / (8 pi) * (n.h)^s * max(n.l, 0) * radiance   normalised
 //              Blinn-Phong, with the exponent s = 2 / roughness^4 - 2 that matches a
 //              microfacet lobe of that roughness, and F0 = SPECULAR (dielectric, ~0.04);
-// plus albedo * ambient. The albedo (vertex colour) carries the baked ambient occlusion.
+// plus albedo * ambient. The albedo (vertex colour) carries the baked ambient occlusion,
+// and the specular is dimmed by the same factor (light that cannot reach a cavity does not
+// glint in it either).
 // Output: linear colour to sRGB with gamma 1/2.2, as pyrender's own shader does.
 // WRAP and SPECULAR are #defines filled in from render_look.json ("shading").
 
@@ -35,6 +37,7 @@ uniform vec3 ambient_light;
 in vec3 world_position;
 in vec3 world_normal;
 in vec3 albedo;
+in float occlusion;
 
 out vec4 frag_color;
 
@@ -61,6 +64,6 @@ void main()
         float nh = max(dot(n, normalize(l + v)), 0.0);
         specular += radiance * (lobe * pow(nh, shininess) * max(nl, 0.0));
     }
-    vec3 color = base * (diffuse / PI + ambient_light) + specular;
+    vec3 color = base * (diffuse / PI + ambient_light) + occlusion * specular;
     frag_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);
 }

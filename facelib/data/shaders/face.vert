@@ -1,6 +1,7 @@
 #version 330 core
 // facelib's face vertex shader: passes world-space position, normal and the per-vertex
-// colour (sRGB converted to linear, ambient occlusion already multiplied in) to face.frag.
+// colour (sRGB converted to linear, ambient occlusion already multiplied in) to face.frag,
+// and the occlusion factor itself (the colour's alpha), which dims the highlights.
 // Attribute locations and the M/V/P uniforms are the ones pyrender binds for any mesh.
 
 layout(location = 0) in vec3 position;
@@ -17,6 +18,7 @@ uniform mat4 P;
 out vec3 world_position;
 out vec3 world_normal;
 out vec3 albedo;
+out float occlusion;
 
 void main()
 {
@@ -27,7 +29,9 @@ void main()
     world_normal = mat3(transpose(inverse(model))) * normal;
 #ifdef COLOR_0_LOC
     albedo = color_0.rgb;
+    occlusion = color_0.a;
 #else
     albedo = vec3(0.8);
+    occlusion = 1.0;
 #endif
 }
