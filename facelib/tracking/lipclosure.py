@@ -29,8 +29,9 @@ from functools import cache
 
 import numpy as np
 
+from facelib.checks import check_number
 from facelib.data import json_data
-from facelib.errors import DataError
+from facelib.errors import DataError, ParameterError
 from facelib.mpeg4 import FAPU_SCALE
 from facelib.tracking.headframe import HeadFrame
 
@@ -119,8 +120,14 @@ def learn_threshold(aperture: np.ndarray, is_open: np.ndarray, *,
                     false_closed: float = 0.15) -> float:
     """The aperture threshold under which only a ``false_closed`` share of the open frames
     (``is_open`` ``(n,) bool``: lips apart in truth) fall: the ``false_closed`` quantile of
-    their apertures ``(n,)``."""
-    a = np.asarray(aperture, np.float64)[np.asarray(is_open, bool)]
-    if not a.size:
-        raise ValueError("need open frames")
-    return float(np.quantile(a, false_closed))
+    their apertures ``(n,)``. ParameterError for mismatched shapes, no open frames or a
+    ``false_closed`` outside [0, 1]."""
+    share = check_number("false_closed", false_closed, low=0.0, high=1.0)
+    apertures = np.asarray(aperture, np.float64)
+    open_mask = np.asarray(is_open, bool)
+    if apertures.ndim != 1 or open_mask.shape != apertures.shape:
+        raise ParameterError(f"aperture {apertures.shape} and is_open {open_mask.shape} must "
+                             "be (n,) arrays of the same frames")
+    if not open_mask.any():
+        raise ParameterError(f"no open frames among the {len(apertures)} to learn from")
+    return float(np.quantile(apertures[open_mask], share))
