@@ -44,7 +44,7 @@ from facelib.errors import DataError, ParameterError, TrackingError
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, fap_table
 from facelib.tracking.headframe import head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
-from facelib.tracking.pose import euler_angles
+from facelib.tracking.pose import HEAD_FAPS, euler_angles
 
 __all__ = ["MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
            "learn_observation", "load_observation", "pose_correction", "save_observation",
@@ -102,9 +102,14 @@ def _normalised(landmarks: np.ndarray, neutral: int | tuple[int, int]
     frame = head_frame(data, layout=layout, span=neutral_span(neutral, len(data)))
     if frame.pose is None:
         raise TrackingError("the observation model needs a rigid head fit")
-    es = frame.fapu["ES"] * FAPU_SCALE
     angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
-    return (frame.landmarks - frame.rest)[..., :2] / es, frame.fapu, angles
+    return _over_es(frame.motion, frame.fapu), frame.fapu, angles
+
+
+def _over_es(displacements: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, L, 2)`` landmark displacements (the unit of ``fapu``) over the user's eye
+    separation ES0, same shape, float64."""
+    return np.asarray(displacements, np.float64) / (fapu["ES"] * FAPU_SCALE)
 
 
 def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
@@ -126,7 +131,8 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     ids = np.asarray(faps, np.int64)
     truth = np.asarray(values, np.float64)[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
-    pose_error = np.asarray(values, np.float64)[:, 47:50] * ANGLE_UNIT - fitted
+    head = [f - 1 for f in HEAD_FAPS]
+    pose_error = np.asarray(values, np.float64)[:, head] * ANGLE_UNIT - fitted
     target = np.hstack([target, pose_error])
     flat = moved.reshape(n, -1)
     centre = flat.mean(axis=0)
@@ -150,10 +156,9 @@ def solve_observation(model: ObservationModel, displacements: np.ndarray,
     """``(n, m) float64`` FAP values of ``model.faps`` from ``(n, L, 2)`` landmark
     displacements (neutral head frame, the unit of ``fapu``), each kept within
     ``model.bounds``; 0 for a frame with no motion."""
-    es = fapu["ES"] * FAPU_SCALE
-    moved = np.asarray(displacements, np.float64).reshape(len(displacements), -1) / es
+    moved = _over_es(displacements, fapu).reshape(len(displacements), -1)
     found = moved @ model.estimator.reshape(moved.shape[1], -1)
-    found *= es / fap_lengths(model.faps, fapu)
+    found *= fapu["ES"] * FAPU_SCALE / fap_lengths(model.faps, fapu)
     return np.clip(found, model.bounds[:, 0], model.bounds[:, 1])
 
 
@@ -165,7 +170,7 @@ def pose_correction(model: ObservationModel, displacements: np.ndarray,
     n = len(displacements)
     if model.pose is None or model.pose_bounds is None:
         return np.zeros((n, 3))
-    moved = np.asarray(displacements, np.float64).reshape(n, -1) / (fapu["ES"] * FAPU_SCALE)
+    moved = _over_es(displacements, fapu).reshape(n, -1)
     found = moved @ model.pose.reshape(moved.shape[1], 3)
     return np.clip(found, model.pose_bounds[:, 0], model.pose_bounds[:, 1])
 

@@ -14,7 +14,11 @@ import numpy as np
 
 from facelib.errors import TrackingError
 
-__all__ = ["HeadPose", "euler_angles", "fit_pose", "refine_pose_2d", "unpose", "unpose_2d"]
+__all__ = ["HEAD_FAPS", "HeadPose", "euler_angles", "fit_pose", "refine_pose_2d", "unpose",
+           "unpose_2d"]
+
+HEAD_FAPS = (48, 49, 50)
+"""FAP ids of head pitch, yaw and roll, the order of :func:`euler_angles`."""
 
 
 @dataclass(frozen=True)
