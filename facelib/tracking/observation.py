@@ -201,19 +201,29 @@ def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> Obse
                     arrays[key] = np.array(raw[key], np.float64)
     except (OSError, KeyError, ValueError) as exc:
         raise DataError(f"not an observation model ({exc})", path=where) from exc
-    m = len(arrays["faps"]) if arrays["faps"].ndim == 1 else -1
-    shape = arrays["estimator"].shape
-    pose_ok = len(shape) == 3 and (("pose" in arrays) == ("pose_bounds" in arrays)
-                                   and arrays.get("pose", np.zeros((shape[0], 2, 3))).shape
-                                   == (shape[0], 2, 3)
-                                   and arrays.get("pose_bounds", np.zeros((3, 2))).shape
-                                   == (3, 2))
-    if m < 0 or not pose_ok or shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
-        raise DataError("observation model arrays disagree in shape", path=where)
+    if not _shapes_agree(arrays):
+        shapes = ", ".join(f"{k} {v.shape}" for k, v in arrays.items())
+        raise DataError(f"observation model arrays disagree in shape: {shapes} (want faps "
+                        "(m,), estimator (L, 2, m), bounds (m, 2) and, both or neither, pose "
+                        "(L, 2, 3) and pose_bounds (3, 2))", path=where)
     for value in arrays.values():
         value.flags.writeable = False
     return ObservationModel(arrays["faps"].astype(np.int64), arrays["estimator"],
                             arrays["bounds"], arrays.get("pose"), arrays.get("pose_bounds"))
+
+
+def _shapes_agree(arrays: Mapping[str, np.ndarray]) -> bool:
+    """Whether the arrays read by :func:`load_observation` fit :class:`ObservationModel`."""
+    faps, estimator = arrays["faps"], arrays["estimator"]
+    if faps.ndim != 1 or estimator.ndim != 3:
+        return False
+    m = len(faps)
+    if estimator.shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
+        return False
+    if ("pose" in arrays) != ("pose_bounds" in arrays):
+        return False
+    return "pose" not in arrays or (arrays["pose"].shape == (estimator.shape[0], 2, 3)
+                                    and arrays["pose_bounds"].shape == (3, 2))
 
 
 @cache

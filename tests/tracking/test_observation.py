@@ -145,3 +145,19 @@ def test_observed_needs_mediapipe_in_3d():
     with pytest.raises(ParameterError):
         learn_observation(camera(random_stream(6, seed=4)), random_stream(6, seed=4),
                           neutral=(0, 4), components=10)
+
+
+def test_load_names_the_arrays_that_disagree(tmp_path):
+    faps, estimator = np.array([3, 4]), np.zeros((478, 2, 2))
+    base = {"faps": faps, "estimator": estimator}
+    cases = {"bounds.npz": {**base, "bounds": np.zeros((3, 2))},  # 3 rows for 2 FAPs
+             "pose.npz": {**base, "bounds": np.zeros((2, 2)),  # pose without pose_bounds
+                          "pose": np.ones((478, 2, 3))}}
+    for name, arrays in cases.items():
+        np.savez(tmp_path / name, **arrays)
+        with pytest.raises(DataError, match=rf"{name}: observation model arrays disagree "
+                                            r"in shape: faps \(2,\), estimator \(478, 2, 2\)"):
+            load_observation(tmp_path / name)
+    np.savez(tmp_path / "good.npz", faps=faps, estimator=estimator, bounds=np.zeros((2, 2)),
+             pose=np.ones((478, 2, 3)), pose_bounds=np.zeros((3, 2)))
+    assert load_observation(tmp_path / "good.npz").pose is not None
