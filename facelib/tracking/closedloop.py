@@ -17,7 +17,7 @@ import numpy as np
 from facelib.checks import check_count
 from facelib.engine import Face, default_face
 from facelib.errors import ParameterError
-from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
@@ -163,7 +163,7 @@ def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
     values[:, [f - 1 for f in HEAD_FAPS]] = 0.0
     moved = face.deform(FapStream(stream.fps, values, stream.mask))
     return (moved[:, top, 1] - moved[:, bottom, 1]).astype(np.float64) / (
-        face.fapu["MNS"] * 1024)
+        face.fapu["MNS"] * FAPU_SCALE)
 
 
 def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
