@@ -34,6 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from facelib import data
+from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import FaceModelError, ParameterError, RenderError
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
@@ -288,11 +289,6 @@ def _light_pose(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
     return pose
 
 
-def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
-    rgb = np.clip(np.asarray(rgb, np.float32), 0.0, 1.0)
-    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
-
-
 def _occluded(linear: np.ndarray, occlusion: Any, strength: float,
               power: np.ndarray | float = 1.0) -> np.ndarray:
     """Linear colours ``(V, 3)`` darkened by baked ambient occlusion.
@@ -307,7 +303,7 @@ def _occluded(linear: np.ndarray, occlusion: Any, strength: float,
     if occlusion.shape != (len(linear),):
         raise FaceModelError(f"face vertex_ao must have shape ({len(linear)},), "
                              f"got {occlusion.shape}")
-    factor = 1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0) ** power)
+    factor = occlusion_factor(occlusion, strength=strength, power=power)
     return (linear * factor[:, None]).astype(np.float32)
 
 
@@ -463,7 +459,7 @@ class FaceRenderer:
         for piece in self._pieces:  # a part may set its own (the eyes)
             spec = self.look.material(piece.name)
             power[piece.vertex_ids] = float(spec.get("occlusion_power", default_power))
-        linear = _occluded(_srgb_to_linear(colors), getattr(face, "vertex_ao", None),
+        linear = _occluded(srgb_to_linear(colors), getattr(face, "vertex_ao", None),
                            self.look.occlusion, power)
         self._colors = [
             np.hstack([linear[p.vertex_ids], np.ones((len(p.vertex_ids), 1), np.float32)])
