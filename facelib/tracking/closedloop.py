@@ -23,9 +23,12 @@ from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.pose import HEAD_FAPS
 
-__all__ = ["ClosedLoop", "closed_loop", "closure_events", "closure_recall", "event_recall",
-           "false_closures", "lip_closures", "lip_gap", "with_head_turns", "with_neutral_lead"]
+__all__ = ["LIPS_TOUCH", "ClosedLoop", "closed_loop", "closure_events", "closure_recall",
+           "event_recall", "false_closures", "lip_closures", "lip_gap", "with_head_turns",
+           "with_neutral_lead"]
 
+LIPS_TOUCH = 0.1
+"""Inner-lip gap (:func:`lip_gap`, in MNS0) under which the lips count as touching."""
 BLINK_FAPS = (19, 20)
 """Upper-lid FAPs whose peaks are blinks."""
 
@@ -166,7 +169,7 @@ def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
         face.fapu["MNS"] * FAPU_SCALE)
 
 
-def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
+def lip_closures(gap: np.ndarray, fps: float, *, closed: float = LIPS_TOUCH,
                  longest: float = 0.4) -> list[tuple[int, int]]:
     """Runs ``[start, stop)`` where the lips close (``gap`` below ``closed`` MNS0) for at
     most ``longest`` seconds between open frames: the closures of p, b and m in speech
@@ -176,7 +179,7 @@ def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
 
 
 def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,
-                   truth_gap: np.ndarray | None = None, closed: float = 0.1,
+                   truth_gap: np.ndarray | None = None, closed: float = LIPS_TOUCH,
                    slack: int = 2) -> float:
     """Share of lip-closure ``events`` (runs ``[start, stop)``) during which the recovered
     ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the recovered stream on the same face) also
@@ -204,7 +207,7 @@ def _parts(shut: np.ndarray, apart: np.ndarray, start: int, stop: int) -> bool:
     return all((~shut[a:b]).any() for a, b in near)
 
 
-def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = 0.1,
+def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = LIPS_TOUCH,
                    slack: int = 2) -> int:
     """Runs of frames where the recovered ``gap`` ``(n,)`` is below ``closed`` but the
     true ``truth_gap`` ``(n,)`` is not, in any frame of the run or within ``slack``: lips
