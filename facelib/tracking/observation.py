@@ -41,7 +41,7 @@ from facelib.atomic import atomic_path
 from facelib.checks import check_count
 from facelib.data import path as data_path
 from facelib.errors import DataError, ParameterError, TrackingError
-from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, fap_table
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, fap_table
 from facelib.tracking.headframe import head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.pose import HEAD_FAPS, euler_angles
@@ -120,8 +120,13 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
 
     ``neutral``: the neutral frame(s); ``components``: principal components of the landmark
-    motion the regression uses (fewer than frames).
+    motion the regression uses (fewer than frames). ParameterError when ``values`` is not
+    one row of 84 FAPs per landmark frame.
     """
+    known = np.asarray(values, np.float64)
+    if known.shape != (len(landmarks), N_FAPS):
+        raise ParameterError(f"values must be ({len(landmarks)}, {N_FAPS}): the FAPs of each "
+                             f"landmark frame, got {known.shape}")
     moved, fapu, fitted = _normalised(landmarks, neutral)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
@@ -129,10 +134,10 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
         raise ParameterError(f"{components} components need more than {components + 1} "
                              f"frames, got {n}")
     ids = np.asarray(faps, np.int64)
-    truth = np.asarray(values, np.float64)[:, ids - 1]
+    truth = known[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
     head = [f - 1 for f in HEAD_FAPS]
-    pose_error = np.asarray(values, np.float64)[:, head] * ANGLE_UNIT - fitted
+    pose_error = known[:, head] * ANGLE_UNIT - fitted
     target = np.hstack([target, pose_error])
     flat = moved.reshape(n, -1)
     centre = flat.mean(axis=0)

@@ -161,3 +161,10 @@ def test_load_names_the_arrays_that_disagree(tmp_path):
     np.savez(tmp_path / "good.npz", faps=faps, estimator=estimator, bounds=np.zeros((2, 2)),
              pose=np.ones((478, 2, 3)), pose_bounds=np.zeros((3, 2)))
     assert load_observation(tmp_path / "good.npz").pose is not None
+
+
+def test_learn_refuses_values_of_other_frames():
+    values = random_stream(60, seed=3)
+    with pytest.raises(ParameterError, match=r"values must be \(60, 84\).* got \(59, 84\)"):
+        learn_observation(camera(values), values[1:], neutral=(0, 4), faps=FAPS,
+                          components=10)
