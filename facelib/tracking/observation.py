@@ -120,20 +120,23 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
 
     ``neutral``: the neutral frame(s); ``components``: principal components of the landmark
-    motion the regression uses (fewer than frames). ParameterError when ``values`` is not
-    one row of 84 FAPs per landmark frame.
+    motion the regression uses (fewer than frames); ``faps``: the distinct FAP ids (1-84) to
+    learn. ParameterError when ``values`` is not one row of 84 FAPs per landmark frame.
     """
     known = np.asarray(values, np.float64)
     if known.shape != (len(landmarks), N_FAPS):
         raise ParameterError(f"values must be ({len(landmarks)}, {N_FAPS}): the FAPs of each "
                              f"landmark frame, got {known.shape}")
+    ids = np.asarray(faps, np.int64)
+    if ids.ndim != 1 or not ids.size or len(set(ids.tolist())) != ids.size or not (
+            (ids >= 1) & (ids <= N_FAPS)).all():
+        raise ParameterError(f"faps must be distinct FAP ids in 1-{N_FAPS}, got {faps!r}")
     moved, fapu, fitted = _normalised(landmarks, neutral)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
     if components > n - 2:
         raise ParameterError(f"{components} components need more than {components + 1} "
                              f"frames, got {n}")
-    ids = np.asarray(faps, np.int64)
     truth = known[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
     head = [f - 1 for f in HEAD_FAPS]

@@ -168,3 +168,11 @@ def test_learn_refuses_values_of_other_frames():
     with pytest.raises(ParameterError, match=r"values must be \(60, 84\).* got \(59, 84\)"):
         learn_observation(camera(values), values[1:], neutral=(0, 4), faps=FAPS,
                           components=10)
+
+
+def test_learn_refuses_fap_ids_outside_the_table():
+    values = random_stream(60, seed=3)
+    for bad in ((0, 3), (3, 85), (3, 3)):  # 0 read column -1 (FAP 84) without a word
+        with pytest.raises(ParameterError, match=r"faps must be distinct FAP ids in 1-84"):
+            learn_observation(camera(values), values, neutral=(0, 4), faps=bad,
+                              components=10)
