@@ -112,6 +112,18 @@ def _over_es(displacements: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray
     return np.asarray(displacements, np.float64) / (fapu["ES"] * FAPU_SCALE)
 
 
+def _model_input(model: ObservationModel, displacements: np.ndarray,
+                 fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, L * 2)`` the displacements ``(n, L, 2)`` over ES0, flattened as the model
+    reads them; ParameterError unless ``L`` is the model's landmark count."""
+    shape = np.shape(displacements)
+    n_land = model.estimator.shape[0]
+    if len(shape) != 3 or shape[1:] != (n_land, 2):
+        raise ParameterError(f"the observation model reads displacements (n, {n_land}, 2), "
+                             f"got {shape}")
+    return _over_es(displacements, fapu).reshape(shape[0], -1)
+
+
 def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                       neutral: int | tuple[int, int] = 0,
                       faps: tuple[int, ...] = MODEL_FAPS,
@@ -163,8 +175,9 @@ def solve_observation(model: ObservationModel, displacements: np.ndarray,
                       fapu: Mapping[str, float]) -> np.ndarray:
     """``(n, m) float64`` FAP values of ``model.faps`` from ``(n, L, 2)`` landmark
     displacements (neutral head frame, the unit of ``fapu``), each kept within
-    ``model.bounds``; 0 for a frame with no motion."""
-    moved = _over_es(displacements, fapu).reshape(len(displacements), -1)
+    ``model.bounds``; 0 for a frame with no motion. ParameterError for another ``L`` than
+    the model's."""
+    moved = _model_input(model, displacements, fapu)
     found = moved @ model.estimator.reshape(moved.shape[1], -1)
     found *= fapu["ES"] * FAPU_SCALE / fap_lengths(model.faps, fapu)
     return np.clip(found, model.bounds[:, 0], model.bounds[:, 1])
@@ -175,10 +188,9 @@ def pose_correction(model: ObservationModel, displacements: np.ndarray,
     """``(n, 3) float64`` correction (radians) to add to the fitted pitch, yaw and roll, from
     ``(n, L, 2)`` landmark displacements (neutral head frame, the unit of ``fapu``), within
     ``model.pose_bounds``; zeros for a model without one."""
-    n = len(displacements)
+    moved = _model_input(model, displacements, fapu)
     if model.pose is None or model.pose_bounds is None:
-        return np.zeros((n, 3))
-    moved = _over_es(displacements, fapu).reshape(n, -1)
+        return np.zeros((len(moved), 3))
     found = moved @ model.pose.reshape(moved.shape[1], 3)
     return np.clip(found, model.pose_bounds[:, 0], model.pose_bounds[:, 1])
 

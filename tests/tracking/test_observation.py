@@ -17,6 +17,7 @@ from facelib.tracking.observation import (
     default_observation,
     learn_observation,
     load_observation,
+    pose_correction,
     save_observation,
     solve_observation,
 )
@@ -176,3 +177,12 @@ def test_learn_refuses_fap_ids_outside_the_table():
         with pytest.raises(ParameterError, match=r"faps must be distinct FAP ids in 1-84"):
             learn_observation(camera(values), values, neutral=(0, 4), faps=bad,
                               components=10)
+
+
+def test_solve_names_displacements_of_another_layout(learned):
+    fapu = {"ES": 1.0, "MNS": 1.0, "MW": 1.0, "ENS": 1.0, "IRISD": 1.0}
+    wrong = np.zeros((5, 468, 2))  # MediaPipe without the irises: the model reads 478
+    with pytest.raises(ParameterError, match=r"\(n, 478, 2\).* got \(5, 468, 2\)"):
+        solve_observation(learned, wrong, fapu)
+    with pytest.raises(ParameterError, match=r"\(n, 478, 2\).* got \(5, 468, 2\)"):
+        pose_correction(learned, wrong, fapu)
