@@ -240,7 +240,7 @@ def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
                                       close_below=rule.close_below,
                                       open_above=rule.open_above)
     mask = mask.copy()
-    mask[:, [3, 4, *(f - 1 for f in rule.neighbours)]] = True
+    mask[:, lipclosure.closed_lip_columns(rule)] = True
     return lipclosure.close_lips(values, closed, rule), mask
 
 

@@ -32,13 +32,16 @@ import numpy as np
 from facelib.checks import check_number
 from facelib.data import json_data
 from facelib.errors import DataError, ParameterError
-from facelib.mpeg4 import FAPU_SCALE
+from facelib.mpeg4 import FAPU_SCALE, fap
 from facelib.tracking.headframe import HeadFrame
 
-__all__ = ["LipClosure", "close_lips", "closed_frames", "inner_lip_aperture",
+__all__ = ["LipClosure", "close_lips", "closed_frames", "closed_lip_columns", "inner_lip_aperture",
            "learn_threshold", "lip_closure"]
 
 _DATA = "tracking/lip_closure.json"
+_JAW, _UPPER, _LOWER = (fap(name).index for name in ("open_jaw", "lower_t_midlip",
+                                                      "raise_b_midlip"))
+"""Columns of FAPs 3, 4 and 5: the jaw and the inner lip midpoints the rule moves."""
 
 
 @dataclass(frozen=True)
@@ -106,14 +109,19 @@ def closed_frames(aperture: np.ndarray, *, close_below: float,
 def close_lips(values: np.ndarray, closed: np.ndarray, rule: LipClosure) -> np.ndarray:
     """``(n, 84)`` FAP values with the inner-lip separation of the ``closed`` ``(n,)``
     frames lowered to at most ``rule.closed_gap`` (FAPs 4, 5 and neighbours raised)."""
-    out = np.array(values, np.float64)
-    separation = rule.jaw_gain * out[:, 2] - out[:, 3] - out[:, 4]
+    values = np.array(values, np.float64)
+    separation = rule.jaw_gain * values[:, _JAW] - values[:, _UPPER] - values[:, _LOWER]
     raise_by = np.where(closed, np.maximum(separation - rule.closed_gap, 0.0) / 2, 0.0)
-    out[:, 3] += raise_by
-    out[:, 4] += raise_by
+    values[:, _UPPER] += raise_by
+    values[:, _LOWER] += raise_by
     for fap_id, share in rule.neighbours.items():
-        out[:, fap_id - 1] += share * raise_by
-    return out
+        values[:, fap_id - 1] += share * raise_by
+    return values
+
+
+def closed_lip_columns(rule: LipClosure) -> list[int]:
+    """The FAP columns :func:`close_lips` may change: FAPs 4, 5 and the rule's neighbours."""
+    return [_UPPER, _LOWER, *(f - 1 for f in rule.neighbours)]
 
 
 def learn_threshold(aperture: np.ndarray, is_open: np.ndarray, *,
