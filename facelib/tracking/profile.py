@@ -41,7 +41,8 @@ _BEHIND = 0.8  # the fan's centre lies this far (x the lid points' distance) beh
 _STEP = 1 / 120  # resampling step (x the same distance): about half a millimetre
 _CHORD = 4  # samples each side of the chord that gives the normal (about 2 mm)
 _LIP_WINDOW = 0.1  # the lower lip's upper face lies this far below the mouth line (x scale)
-_FAN_DEG = (45.0, -120.0, 661)  # from up-forward past straight down, in the y-z plane
+_FAN_DEG = (45.0, -120.0)  # the rays' angles, from up-forward past straight down (y-z plane)
+_FAN_RAYS = 661  # rays in the fan (a quarter of a degree apart)
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,7 +82,7 @@ def _cuts(vertices: np.ndarray, triangles: np.ndarray, x: float) -> np.ndarray:
 def _fan(cuts: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The last hit ``(m, 2)`` (y, z) of each fan ray from ``centre (2,)`` on the cut
     segments, and the rays' angles (radians) of those that hit."""
-    angles = np.radians(np.linspace(*_FAN_DEG[:2], int(_FAN_DEG[2])))
+    angles = np.radians(np.linspace(*_FAN_DEG, _FAN_RAYS))
     start, edge = cuts[:, 0] - centre, cuts[:, 1] - cuts[:, 0]
     hits, kept = [], []
     for angle in angles:
