@@ -286,10 +286,10 @@ def _on_profile(mesh: HeadMesh, points: dict[str, np.ndarray]) -> dict[str, np.n
     """The found points of :data:`~facelib.tracking.profile.PROFILE_POINTS` placed again
     from the mesh's midline profile (:mod:`facelib.tracking.profile`)."""
     from facelib.engine import default_face
-    from facelib.tracking.profile import PROFILE_POINTS, profile_points
+    from facelib.tracking.profile import PROFILE_NEEDS, PROFILE_POINTS, profile_points
 
     wanted = [k for k in PROFILE_POINTS if k in points]
-    if not wanted or not all(k in points for k in ("3.1", "3.2", "8.1", "8.2")):
+    if not wanted or not all(k in points for k in PROFILE_NEEDS):
         return {}
     src = default_face()
     source = (src.vertices.astype(np.float64), src.parts["skin"].triangles,

@@ -30,11 +30,12 @@ import numpy as np
 
 from facelib.errors import FaceModelError
 
-__all__ = ["PROFILE_POINTS", "Profile", "midline_profile", "profile_points"]
+__all__ = ["PROFILE_NEEDS", "PROFILE_POINTS", "Profile", "midline_profile", "profile_points"]
 
 PROFILE_POINTS = ("9.3", "8.2", "2.1", "2.10")
 """Feature points :func:`profile_points` places from the profile."""
-_NEEDED = ("3.1", "3.2", "8.1", "8.2")  # what the fan's centre and the scale come from
+PROFILE_NEEDS = ("3.1", "3.2", "8.1", "8.2")
+"""Feature points :func:`profile_points` needs on both faces (the fan's centre and scale)."""
 _MIDLINE = ("8.1", "8.2", "2.2", "9.3", "2.1", "2.10")  # the median x of these is the plane
 _SOURCE_NEEDED = ("2.1", "2.10")  # the source's points whose normals are matched
 _BEHIND = 0.8  # the fan's centre lies this far (x the lid points' distance) behind the mouth
@@ -124,7 +125,7 @@ def _profile_of(vertices: np.ndarray, triangles: np.ndarray,
     points ``points`` (each ``(3,)``), nudged off a mirrored mesh's midline vertices by a
     millionth of the lid points' distance. FaceModelError naming ``whose`` points are
     missing."""
-    missing = [k for k in _NEEDED if k not in points]
+    missing = [k for k in PROFILE_NEEDS if k not in points]
     if missing:
         raise FaceModelError(f"the midline profile{whose} needs feature points "
                              f"{', '.join(missing)}")
