@@ -209,10 +209,13 @@ def save_observation(model: ObservationModel, path: str | os.PathLike[str]) -> P
     return Path(path)
 
 
-def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> ObservationModel:
+def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase, *,
+                     name: str | None = None) -> ObservationModel:
     """Read a model written by :func:`save_observation` (the pose arrays may be absent or
-    empty); DataError if it is malformed."""
-    where = str(source) if isinstance(source, (str, os.PathLike)) else _DATA
+    empty); DataError if it is malformed, naming ``name`` (default: the path, or
+    ``<stream>`` for an open stream)."""
+    if name is None:
+        name = str(source) if isinstance(source, (str, os.PathLike)) else "<stream>"
     try:
         with np.load(source, allow_pickle=False) as raw:
             arrays = {k: np.array(raw[k], np.float64) for k in ("faps", "estimator", "bounds")}
@@ -220,12 +223,12 @@ def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> Obse
                 if key in raw.files and raw[key].size:
                     arrays[key] = np.array(raw[key], np.float64)
     except (OSError, KeyError, ValueError) as exc:
-        raise DataError(f"not an observation model ({exc})", path=where) from exc
+        raise DataError(f"not an observation model ({exc})", path=name) from exc
     if not _shapes_agree(arrays):
         shapes = ", ".join(f"{k} {v.shape}" for k, v in arrays.items())
         raise DataError(f"observation model arrays disagree in shape: {shapes} (want faps "
                         "(m,), estimator (L, 2, m), bounds (m, 2) and, both or neither, pose "
-                        "(L, 2, 3) and pose_bounds (3, 2))", path=where)
+                        "(L, 2, 3) and pose_bounds (3, 2))", path=name)
     for value in arrays.values():
         value.flags.writeable = False
     return ObservationModel(arrays["faps"].astype(np.int64), arrays["estimator"],
@@ -251,4 +254,4 @@ def default_observation() -> ObservationModel:
     """The packaged model: MediaPipe's 478 landmarks on the default head at 640x480
     (``facelib/data/tracking/observation_mediapipe.npz``)."""
     with data_path(_DATA).open("rb") as f:
-        return load_observation(io.BytesIO(f.read()))
+        return load_observation(io.BytesIO(f.read()), name=_DATA)

@@ -4,6 +4,8 @@ default head deformed by known FAPs, its MediaPipe-embedded vertices projected l
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 import pytest
 
@@ -186,3 +188,10 @@ def test_solve_names_displacements_of_another_layout(learned):
         solve_observation(learned, wrong, fapu)
     with pytest.raises(ParameterError, match=r"\(n, 478, 2\).* got \(5, 468, 2\)"):
         pose_correction(learned, wrong, fapu)
+
+
+def test_a_bad_stream_is_not_blamed_on_the_packaged_model():
+    with pytest.raises(DataError) as caught:
+        load_observation(io.BytesIO(b"not an npz"))
+    assert "observation_mediapipe" not in str(caught.value)
+    assert str(caught.value).startswith("<stream>: not an observation model")
