@@ -21,7 +21,7 @@ from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
-from facelib.tracking.pose import HEAD_FAPS
+from facelib.tracking.pose import HEAD_FAP_IDS
 
 __all__ = ["LIPS_TOUCH", "ClosedLoop", "closed_loop", "closure_events", "closure_recall",
            "event_recall", "false_closures", "lip_closures", "lip_gap", "with_head_turns",
@@ -163,7 +163,7 @@ def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
     does not change it), in units of the face's MNS0 (0 = lips touching)."""
     top, bottom = face.feature_points["2.2"], face.feature_points["2.3"]
     values = np.array(stream.values)
-    values[:, [f - 1 for f in HEAD_FAPS]] = 0.0
+    values[:, [f - 1 for f in HEAD_FAP_IDS]] = 0.0
     moved = face.deform(FapStream(stream.fps, values, stream.mask))
     return (moved[:, top, 1] - moved[:, bottom, 1]).astype(np.float64) / (
         face.fapu["MNS"] * FAPU_SCALE)

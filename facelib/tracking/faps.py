@@ -54,7 +54,7 @@ from facelib.tracking.observation import (
     pose_correction,
     solve_observation,
 )
-from facelib.tracking.pose import HEAD_FAPS, HeadPose, euler_angles
+from facelib.tracking.pose import HEAD_FAP_IDS, HeadPose, euler_angles
 from facelib.tracking.relations import apply_relations
 from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
@@ -314,8 +314,8 @@ def measure_faps(
         angles = np.stack(euler_angles(pose.rotation), axis=1)
         if isinstance(model, ObservationModel):  # the fit's learned error taken out
             angles += pose_correction(model, frame.motion, frame.fapu)
-        values[:, [f - 1 for f in HEAD_FAPS]] = angles / ANGLE_UNIT
-        mask[:, [f - 1 for f in HEAD_FAPS]] = True
+        values[:, [f - 1 for f in HEAD_FAP_IDS]] = angles / ANGLE_UNIT
+        mask[:, [f - 1 for f in HEAD_FAP_IDS]] = True
     lips = (frame, layout) if close_lips and model is not None else None
     values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
                            relations=relations, lips=lips)

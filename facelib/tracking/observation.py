@@ -44,7 +44,7 @@ from facelib.errors import DataError, ParameterError, TrackingError
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, fap_table
 from facelib.tracking.headframe import head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
-from facelib.tracking.pose import HEAD_FAPS, euler_angles
+from facelib.tracking.pose import HEAD_FAP_IDS, euler_angles
 
 __all__ = ["MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
            "learn_observation", "load_observation", "pose_correction", "save_observation",
@@ -151,7 +151,7 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                              f"frames, got {n}")
     truth = known[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
-    head = [f - 1 for f in HEAD_FAPS]
+    head = [f - 1 for f in HEAD_FAP_IDS]
     pose_error = known[:, head] * ANGLE_UNIT - fitted
     target = np.hstack([target, pose_error])
     flat = moved.reshape(n, -1)
