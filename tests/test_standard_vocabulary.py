@@ -26,7 +26,9 @@ def _bare_fap_columns(path: Path) -> list[str]:
     return found
 
 
-@pytest.mark.parametrize("module", ["engine/face.py", "gaze/animate.py", "sync/combine.py"])
+@pytest.mark.parametrize("module", ["engine/face.py", "gaze/animate.py", "sync/combine.py",
+                                    "tracking/lipclosure.py", "tracking/observation.py",
+                                    "tracking/closedloop.py", "tracking/faps.py"])
 def test_no_bare_fap_columns(module):
     assert _bare_fap_columns(PACKAGE / module) == []
 

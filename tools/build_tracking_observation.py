@@ -38,7 +38,7 @@ from facelib.data import path as data_path
 from facelib.engine import default_face
 from facelib.expressions import default_library
 from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream, fap, fap_table
-from facelib.tracking.closedloop import lip_gap, with_neutral_lead
+from facelib.tracking.closedloop import LIPS_TOUCH, lip_gap, with_neutral_lead
 from facelib.tracking.headframe import fill_gaps, head_frame
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.lipclosure import inner_lip_aperture, learn_threshold, lip_closure
@@ -202,9 +202,9 @@ def write_closure_threshold(tracks: list[np.ndarray], streams: list[FapStream]) 
         apertures.append(inner_lip_aperture(frame, rule)[NEUTRAL:])
         gaps.append(lip_gap(default_face(), stream)[NEUTRAL:])
     aperture, gap = np.concatenate(apertures), np.concatenate(gaps)
-    threshold = round(learn_threshold(aperture, gap >= 0.1), 4)
+    threshold = round(learn_threshold(aperture, gap >= LIPS_TOUCH), 4)
     raw = json.loads(CLOSURE.read_text())
-    n_open = int((gap >= 0.1).sum())
+    n_open = int((gap >= LIPS_TOUCH).sum())
     source = (f"learned by tools/build_tracking_observation.py: 15 % of the {n_open} "
               f"training frames whose inner lips are apart (gap >= 0.1 MNS0 on the default "
               f"head) have a smaller aperture; no hysteresis (open_above = close_below)")

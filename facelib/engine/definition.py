@@ -158,15 +158,16 @@ class _Reader:
         if c.shape != v.shape:
             raise self.fail(f"vertex_colors must have shape {v.shape}, got {c.shape}")
         c = c / 255.0 if np.issubdtype(c.dtype, np.integer) else c.astype(np.float64)
-        self.occlusion = None if occlusion is None else self.unit_values(occlusion, len(v))
+        self.occlusion = None if occlusion is None else self.occlusion_values(occlusion, len(v))
         return v, t, np.clip(c, 0.0, 1.0)
 
-    def unit_values(self, values: np.ndarray, nv: int) -> np.ndarray:
-        """``vertex_ao`` as ``(V,) float`` in [0, 1] (uint8 0-255 or floats)."""
+    def occlusion_values(self, values: np.ndarray, nv: int) -> np.ndarray:
+        """The mesh's ``vertex_ao`` as ``(V,) float64`` in [0, 1]: integers as 0-255
+        (uint8), floats as they are, both clipped to the range."""
         if values.shape != (nv,):
             raise self.fail(f"vertex_ao must have shape ({nv},), got {values.shape}")
         if np.issubdtype(values.dtype, np.integer):
-            return values / 255.0
+            return np.clip(values / 255.0, 0.0, 1.0)
         if not np.all(np.isfinite(values)):
             raise self.fail("vertex_ao must be finite")
         return np.clip(values.astype(np.float64), 0.0, 1.0)

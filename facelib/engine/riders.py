@@ -37,6 +37,7 @@ class Riders:
 
     @property
     def size(self) -> int:
+        """The number of riders ``R``."""
         return int(self.vertices.size)
 
     def check(self, n_vertices: int, region_vertices: np.ndarray) -> None:
@@ -60,7 +61,9 @@ class Riders:
                                  "region; a rider only follows its anchors")
 
     def operator(self, operator: sp.csr_array) -> sp.csr_array:
-        """``operator`` (84, 3V) with each rider's columns set to the blend of its anchors'."""
+        """``operator`` ``(84, 3V)`` float32 with the blend of each rider's anchors' columns
+        added to the rider's own (x, y, z) columns, which are zero: a rider belongs to no
+        region (:meth:`check`), so the result is the blend."""
         if self.size == 0:
             return operator
         n = operator.shape[1]

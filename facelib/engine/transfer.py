@@ -35,7 +35,7 @@ from facelib.engine.fapu import compute_fapu
 from facelib.engine.headmesh import HeadMesh
 from facelib.engine.surface import Surface, SurfacePoints, closest_points, surface, vertex_normals
 from facelib.engine.tps import ThinPlateSpline
-from facelib.mpeg4.tables import fap_table
+from facelib.mpeg4.tables import FAPU_SCALE, fap_table
 
 __all__ = ["transfer_face"]
 
@@ -251,7 +251,7 @@ def _closed_lids(regions: tuple[Region, ...], *, verts: np.ndarray, skin: np.nda
             continue
         centre = pivots[region.pivot]
         full = rigid.hinge_angle(verts[points[fp_id]], centre,
-                                 np.array([1024 * fapu[info.fapu] * info.direction[1]]))[0]
+                                 np.array([FAPU_SCALE * fapu[info.fapu] * info.direction[1]]))[0]
         radius = float(np.linalg.norm(verts[eyes[region.pivot]] - centre, axis=1).max())
         out.append(close_upper_lid(region, vertices=verts, triangles=skin, centre=centre,
                                    radius=radius, full_angle=float(full)))

@@ -20,6 +20,7 @@ import numpy as np
 from facelib import data
 from facelib.atomic import atomic_path
 from facelib.engine import Face, default_face
+from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import MissingExtraError, ParameterError
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, resolve_source
@@ -113,24 +114,20 @@ def _import_pygltflib() -> Any:
     return pygltflib
 
 
-def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
-    """glTF vertex colours are linear; facelib's are sRGB."""
-    rgb = np.clip(np.asarray(rgb, np.float32), 0.0, 1.0)
-    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4).astype(np.float32)
-
-
 def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarray:
     """``(V, 3)`` linear colours with the face's baked ambient occlusion multiplied in as
     facelib's renderer does: ``1 - strength * (1 - ao ** power)`` (``render_look.json``
-    ``occlusion``; a part's material may set its own ``occlusion_power``)."""
+    ``occlusion``; a part's material may set its own ``occlusion_strength`` and
+    ``occlusion_power``)."""
     if face.vertex_ao is None:
         return linear
     spec, out = look["occlusion"], linear.copy()
     for name, part in face.parts.items():
         material = look["parts"].get(name, look["parts"]["default"])
         power = float(material.get("occlusion_power", spec["power"]))
-        ao = face.vertex_ao[part.vertex_ids] ** power
-        out[part.vertex_ids] *= (1.0 - float(spec["strength"]) * (1.0 - ao))[:, None]
+        strength = float(material.get("occlusion_strength", spec["strength"]))
+        out[part.vertex_ids] *= occlusion_factor(face.vertex_ao[part.vertex_ids],
+                                                 strength=strength, power=power)[:, None]
     return out
 
 
@@ -155,7 +152,7 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     # each target's change of the normals, so that players shade the deformed face right
     normal_turns = [vertex_normals(face.vertices + disp, face.triangles) - normals
                     for disp in targets]
-    colours = _occluded(_srgb_to_linear(face.vertex_colors), face, look_data)
+    colours = _occluded(srgb_to_linear(face.vertex_colors), face, look_data)  # glTF's: linear
     joints = np.zeros((face.n_vertices, 4), np.uint16)
     joints[:, :2] = rig.joints
     weights = np.zeros((face.n_vertices, 4), np.float32)

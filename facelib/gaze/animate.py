@@ -207,8 +207,8 @@ def _render(
     times = np.arange(n_frames, dtype=float) / fps
     gaze = planner.gaze.sample(times)
     head = planner.head.sample(times)
-    still = 0.0 if fixation is None else fixation.offsets  # fixational drift, micro-saccades
-    eyes = np.clip(gaze - head + still, planner.eye_lo, planner.eye_hi)
+    drift = 0.0 if fixation is None else fixation.offsets  # (n, 2) deg: drift, micro-saccades
+    eyes = np.clip(gaze - head + drift, planner.eye_lo, planner.eye_hi)
     closure = blink_closure(times, blinks, frame_s=1.0 / fps)
     b = model["blink"]
     upper_open, lower_open = _open_lids(planner.lid.sample(times)[:, 0], eyes[:, 1])

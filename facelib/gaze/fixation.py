@@ -47,8 +47,8 @@ def hold_envelope(times: np.ndarray, saccades: Sequence[Saccade]) -> np.ndarray:
     order = np.argsort(starts, kind="stable")
     starts = starts[order]
     ends = np.array([s.start + s.duration for s in saccades], dtype=float)[order]
-    last = np.searchsorted(starts, times, side="right") - 1
-    held_from = np.where(last >= 0, ends[np.maximum(last, 0)] if ends.size else 0.0, 0.0)
+    last = np.searchsorted(starts, times, side="right")  # 1 + the last saccade begun
+    held_from = np.r_[0.0, ends][last]  # its end, or the start of the clip (0 s)
     since = times - held_from
     ramp = np.clip((since - float(p["onset_s"])) / float(p["ramp_s"]), 0.0, 1.0)
     return np.where(since < 0.0, 0.0, ramp)

@@ -40,6 +40,8 @@ def camera_cues_of(source: object) -> tuple[Any, ...]:
 
 def _framed(renderer: FaceRenderer, face: Any, framing: str | np.ndarray
             ) -> tuple[np.ndarray, float, float]:
+    """The camera that frames ``framing`` (a look's framing name, or ``(k, 3)`` points to
+    frame) on ``face``: ``(4, 4)`` pose (camera to face coordinates), znear, zfar."""
     points = (framing_points(face, framing, look=renderer.look) if isinstance(framing, str)
               else np.asarray(framing, np.float32))
     return frame_camera(points, aspect=renderer.width / renderer.height,
@@ -48,18 +50,28 @@ def _framed(renderer: FaceRenderer, face: Any, framing: str | np.ndarray
                         scene_vertices=np.asarray(face.vertices, np.float32))
 
 
+def _targets(renderer: FaceRenderer, face: Any, cues: Sequence[Any]
+             ) -> dict[str, tuple[np.ndarray, float, float]]:
+    """The framed camera (pose, znear, zfar) of each framing the ``cues`` name;
+    ParameterError, with the cue's storyboard file and line where it has them, for a
+    framing the look does not have."""
+    targets: dict[str, tuple[np.ndarray, float, float]] = {}
+    for cue in cues:
+        name = str(cue.framing)
+        if name not in renderer.look.framings:
+            path, line = getattr(cue, "origin", None) or (None, None)
+            raise ParameterError(f"camera cue framing {name!r} is not one of "
+                                 f"{tuple(renderer.look.framings)}", path=path, line=line)
+        targets.setdefault(name, _framed(renderer, face, name))
+    return targets
+
+
 def camera_track(renderer: FaceRenderer, face: Any, cues: Sequence[Any], *, n_frames: int,
                  fps: float, framing: str | np.ndarray) -> CameraTrack:
     """One camera per frame of an ``n_frames`` render at ``fps``: ``framing`` until the
     first cue, then each cue's cut or move (see the module docstring)."""
     start = _framed(renderer, face, framing)
-    targets: dict[str, tuple[np.ndarray, float, float]] = {}
-    for cue in cues:
-        name = str(cue.framing)
-        if name not in renderer.look.framings:
-            raise ParameterError(f"camera cue framing {name!r} is not one of "
-                                 f"{tuple(renderer.look.framings)}")
-        targets.setdefault(name, _framed(renderer, face, name))
+    targets = _targets(renderer, face, cues)
     times = np.arange(n_frames) * 1000.0 / fps
     pos = np.tile(start[0][:3, 3], (n_frames, 1))
     near = np.full(n_frames, start[1])

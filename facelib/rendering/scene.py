@@ -34,6 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from facelib import data
+from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import FaceModelError, ParameterError, RenderError
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
@@ -288,11 +289,6 @@ def _light_pose(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
     return pose
 
 
-def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
-    rgb = np.clip(np.asarray(rgb, np.float32), 0.0, 1.0)
-    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
-
-
 def _part_occlusion(look: Look, pieces: Sequence[Any], n: int) -> tuple[np.ndarray, np.ndarray]:
     """``(n,)`` occlusion strength and power of each vertex: the look's, or its part's own
     (``occlusion_strength``, ``occlusion_power`` in the part's material)."""
@@ -318,7 +314,7 @@ def _occlusion_factor(n: int, occlusion: Any, strength: np.ndarray | float,
     occlusion = np.asarray(occlusion, np.float32)
     if occlusion.shape != (n,):
         raise FaceModelError(f"face vertex_ao must have shape ({n},), got {occlusion.shape}")
-    return (1.0 - strength * (1.0 - np.clip(occlusion, 0.0, 1.0) ** power)).astype(np.float32)
+    return occlusion_factor(occlusion, strength=strength, power=power)
 
 
 def _face_arrays(face: Deformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -474,7 +470,7 @@ class FaceRenderer:
         # nothing with it (its blend function is ONE, ZERO for opaque materials)
         factor = _occlusion_factor(len(colors), getattr(face, "vertex_ao", None),
                                    strength, power)
-        linear = _srgb_to_linear(colors) * factor[:, None]
+        linear = srgb_to_linear(colors) * factor[:, None]
         self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
                         for p in self._pieces]
         self._materials = [self._material(p.name) for p in self._pieces]

@@ -17,14 +17,18 @@ import numpy as np
 from facelib.checks import check_count
 from facelib.engine import Face, default_face
 from facelib.errors import ParameterError
-from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+from facelib.tracking.pose import HEAD_FAP_IDS
 
-__all__ = ["ClosedLoop", "closed_loop", "closure_events", "closure_recall", "event_recall",
-           "false_closures", "lip_closures", "lip_gap", "with_head_turns", "with_neutral_lead"]
+__all__ = ["LIPS_TOUCH", "ClosedLoop", "closed_loop", "closure_events", "closure_recall",
+           "event_recall", "false_closures", "lip_closures", "lip_gap", "with_head_turns",
+           "with_neutral_lead"]
 
+LIPS_TOUCH = 0.1
+"""Inner-lip gap (:func:`lip_gap`, in MNS0) under which the lips count as touching."""
 BLINK_FAPS = (19, 20)
 """Upper-lid FAPs whose peaks are blinks."""
 
@@ -159,13 +163,13 @@ def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
     does not change it), in units of the face's MNS0 (0 = lips touching)."""
     top, bottom = face.feature_points["2.2"], face.feature_points["2.3"]
     values = np.array(stream.values)
-    values[:, 47:50] = 0.0
+    values[:, [f - 1 for f in HEAD_FAP_IDS]] = 0.0
     moved = face.deform(FapStream(stream.fps, values, stream.mask))
     return (moved[:, top, 1] - moved[:, bottom, 1]).astype(np.float64) / (
-        face.fapu["MNS"] * 1024)
+        face.fapu["MNS"] * FAPU_SCALE)
 
 
-def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
+def lip_closures(gap: np.ndarray, fps: float, *, closed: float = LIPS_TOUCH,
                  longest: float = 0.4) -> list[tuple[int, int]]:
     """Runs ``[start, stop)`` where the lips close (``gap`` below ``closed`` MNS0) for at
     most ``longest`` seconds between open frames: the closures of p, b and m in speech
@@ -175,7 +179,7 @@ def lip_closures(gap: np.ndarray, fps: float, *, closed: float = 0.1,
 
 
 def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,
-                   truth_gap: np.ndarray | None = None, closed: float = 0.1,
+                   truth_gap: np.ndarray | None = None, closed: float = LIPS_TOUCH,
                    slack: int = 2) -> float:
     """Share of lip-closure ``events`` (runs ``[start, stop)``) during which the recovered
     ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the recovered stream on the same face) also
@@ -203,7 +207,7 @@ def _parts(shut: np.ndarray, apart: np.ndarray, start: int, stop: int) -> bool:
     return all((~shut[a:b]).any() for a, b in near)
 
 
-def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = 0.1,
+def false_closures(truth_gap: np.ndarray, gap: np.ndarray, *, closed: float = LIPS_TOUCH,
                    slack: int = 2) -> int:
     """Runs of frames where the recovered ``gap`` ``(n,)`` is below ``closed`` but the
     true ``truth_gap`` ``(n,)`` is not, in any frame of the run or within ``slack``: lips

@@ -54,7 +54,7 @@ from facelib.tracking.observation import (
     pose_correction,
     solve_observation,
 )
-from facelib.tracking.pose import HeadPose, euler_angles
+from facelib.tracking.pose import HEAD_FAP_IDS, HeadPose, euler_angles
 from facelib.tracking.relations import apply_relations
 from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
@@ -66,7 +66,6 @@ __all__ = ["TrackedFaps", "face_frame", "fill_gaps", "frame_spans", "landmarks_t
 _AXES = {"x": 0, "y": 1, "z": 2}
 _EYES = (("3.5", "3.7", "3.11", 23, 25), ("3.6", "3.12", "3.8", 24, 26))
 """(pupil, corner, corner, yaw FAP, pitch FAP) per eye."""
-_HEAD = (48, 49, 50)
 
 
 @dataclass(frozen=True)
@@ -205,7 +204,7 @@ def _inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
 def _observe(frame: HeadFrame, model: ObservationModel, *, values: np.ndarray,
              mask: np.ndarray) -> None:
     """FAPs of ``model`` from the landmark motion (:mod:`~facelib.tracking.observation`)."""
-    found = solve_observation(model, (frame.landmarks - frame.rest)[..., :2], frame.fapu)
+    found = solve_observation(model, frame.motion, frame.fapu)
     values[:, model.faps - 1] = found
     mask[:, model.faps - 1] = True
 
@@ -241,7 +240,7 @@ def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
                                       close_below=rule.close_below,
                                       open_above=rule.open_above)
     mask = mask.copy()
-    mask[:, [3, 4, *(f - 1 for f in rule.neighbours)]] = True
+    mask[:, lipclosure.closed_lip_columns(rule)] = True
     return lipclosure.close_lips(values, closed, rule), mask
 
 
@@ -314,10 +313,9 @@ def measure_faps(
     if pose is not None:
         angles = np.stack(euler_angles(pose.rotation), axis=1)
         if isinstance(model, ObservationModel):  # the fit's learned error taken out
-            angles += pose_correction(model, (frame.landmarks - frame.rest)[..., :2],
-                                      frame.fapu)
-        values[:, [f - 1 for f in _HEAD]] = angles / ANGLE_UNIT
-        mask[:, [f - 1 for f in _HEAD]] = True
+            angles += pose_correction(model, frame.motion, frame.fapu)
+        values[:, [f - 1 for f in HEAD_FAP_IDS]] = angles / ANGLE_UNIT
+        mask[:, [f - 1 for f in HEAD_FAP_IDS]] = True
     lips = (frame, layout) if close_lips and model is not None else None
     values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
                            relations=relations, lips=lips)

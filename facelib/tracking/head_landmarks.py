@@ -18,6 +18,8 @@ eyeballs.
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
 
@@ -210,46 +212,66 @@ def _refined(mesh: HeadMesh, points: dict[str, np.ndarray], pixels: dict[str, np
 def _settle(mesh: HeadMesh, pixels: dict[str, np.ndarray], points: dict[str, np.ndarray],
             *, camera: tuple[np.ndarray, np.ndarray, int], front: float
             ) -> dict[str, np.ndarray]:
-    """Eyelid points moved onto their lid's rim and mouth corners into their fold.
-
-    A lid point's pixel may fall just inside the eye opening, where the ray meets the
-    socket behind the lid: walking from it toward the lid (up for the upper lids, down for
-    the lower ones, up to :data:`_WALK` of the lid points' pixel distance), the first step
-    whose hit comes forward by more than :data:`_JUMP` (x their distance) is the rim, and
-    its hit the point. A corner's pixel may fall on the cheek in front of the fold: the
-    deepest hit within :data:`_STENCIL` of its pixel (at most :data:`_FOLD` behind the
-    nearest) is the corner. Rays through an opening (far behind the face) do not count.
-    """
+    """Eyelid points moved onto their lid's rim (:func:`_on_rims`) and mouth corners into
+    their fold (:func:`_in_folds`); ``{}`` without both upper lid points, which set the
+    scale. Rays through an opening (far behind the face's ``front``) do not count."""
     if not all(k in pixels for k in ("3.1", "3.2")):
         return {}
     spread = float(np.linalg.norm(pixels["3.1"] - pixels["3.2"]))
     size3d = float(np.linalg.norm(points["3.1"] - points["3.2"]))
     behind = front + _HOLE_DEPTH * float(np.ptp(mesh.vertices[mesh.parts["skin"]], axis=0).max())
+    hit_at = functools.partial(_raw_hits, mesh, camera=camera, behind=behind)
+    return {**_on_rims(hit_at, pixels, spread=spread, size3d=size3d),
+            **_in_folds(hit_at, pixels, spread=spread, size3d=size3d)}
+
+
+def _on_rims(hit_at: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+             pixels: dict[str, np.ndarray], *, spread: float, size3d: float
+             ) -> dict[str, np.ndarray]:
+    """Eyelid points on their lid's rim. A lid point's pixel may fall just inside the eye
+    opening, where the ray meets the socket behind the lid: walking from it toward the lid
+    (up for the upper lids, down for the lower ones, up to :data:`_WALK` of the lid points'
+    pixel distance ``spread``), the first step whose hit comes forward by more than
+    :data:`_JUMP` (x their distance ``size3d`` on the mesh) is the rim, and its hit the
+    point. ``hit_at``: pixels ``(n, 2)`` -> hits ``(n, 3)`` and depths ``(n,)`` (NaN through
+    an opening)."""
     out = {}
     for fp, way in _LIDS.items():
         if fp in pixels:
             steps = np.arange(0, int(np.ceil(_WALK * spread)) + 1)[:, None] * [0.0, way]
-            hits, depth = _raw_hits(mesh, pixels[fp] + steps, camera, behind)
+            hits, depth = hit_at(pixels[fp] + steps)
             depth = np.where(np.isnan(depth), np.inf, depth)  # through the opening
             with np.errstate(invalid="ignore"):
                 jump = np.flatnonzero((depth[:-1] - depth[1:] > _JUMP * size3d)
                                       & np.isfinite(depth[1:]))
             if jump.size:
                 out[fp] = hits[jump[-1] + 1]
+    return out
+
+
+def _in_folds(hit_at: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+              pixels: dict[str, np.ndarray], *, spread: float, size3d: float
+              ) -> dict[str, np.ndarray]:
+    """Mouth corners at the bottom of their fold. A corner's pixel may fall on the cheek in
+    front of the fold: the deepest hit within :data:`_STENCIL` (x ``spread``, pixels) of
+    its pixel, at most :data:`_FOLD` (x ``size3d``) behind the nearest, is the corner.
+    ``hit_at`` as in :func:`_on_rims`."""
     radius = _STENCIL * spread
     grid = np.arange(-np.ceil(radius), np.ceil(radius) + 1)
     disc = np.array([(a, b) for a in grid for b in grid if a * a + b * b <= radius * radius])
+    out = {}
     for fp in _CORNERS:
         if fp in pixels:
-            hits, depth = _raw_hits(mesh, pixels[fp] + disc, camera, behind)
+            hits, depth = hit_at(pixels[fp] + disc)
             if not np.isnan(depth).all():
                 limit = float(np.nanmin(depth)) + _FOLD * size3d
                 out[fp] = hits[int(np.nanargmax(np.where(depth <= limit, depth, np.nan)))]
     return out
 
 
-def _raw_hits(mesh: HeadMesh, pixels: np.ndarray, camera: tuple[np.ndarray, np.ndarray, int],
-              behind: float) -> tuple[np.ndarray, np.ndarray]:
+def _raw_hits(mesh: HeadMesh, pixels: np.ndarray, *,
+              camera: tuple[np.ndarray, np.ndarray, int], behind: float
+              ) -> tuple[np.ndarray, np.ndarray]:
     """First hits ``(n, 3)`` of the rays through ``pixels (n, 2)`` and their depths ``(n,)``
     along the ray (NaN for a miss or a hit deeper than ``behind``)."""
     pose, projection, size = camera
@@ -264,10 +286,10 @@ def _on_profile(mesh: HeadMesh, points: dict[str, np.ndarray]) -> dict[str, np.n
     """The found points of :data:`~facelib.tracking.profile.PROFILE_POINTS` placed again
     from the mesh's midline profile (:mod:`facelib.tracking.profile`)."""
     from facelib.engine import default_face
-    from facelib.tracking.profile import PROFILE_POINTS, profile_points
+    from facelib.tracking.profile import PROFILE_NEEDS, PROFILE_POINTS, profile_points
 
     wanted = [k for k in PROFILE_POINTS if k in points]
-    if not wanted or not all(k in points for k in ("3.1", "3.2", "8.1", "8.2")):
+    if not wanted or not all(k in points for k in PROFILE_NEEDS):
         return {}
     src = default_face()
     source = (src.vertices.astype(np.float64), src.parts["skin"].triangles,

@@ -44,6 +44,12 @@ class HeadFrame:
     fapu: dict[str, float]
     pose: HeadPose | None
 
+    @property
+    def motion(self) -> np.ndarray:
+        """``(n, K, 2) float64`` every landmark's ``x, y`` displacement from ``rest`` (the
+        landmarks' unit): what the observation model reads."""
+        return (self.landmarks - self.rest)[..., :2]
+
 
 def face_frame(landmarks: np.ndarray) -> np.ndarray:
     """Image coordinates (column, row[, depth toward the scene]) -> the face frame (``x``

@@ -29,15 +29,19 @@ from functools import cache
 
 import numpy as np
 
+from facelib.checks import check_number
 from facelib.data import json_data
-from facelib.errors import DataError
-from facelib.mpeg4 import FAPU_SCALE
+from facelib.errors import DataError, ParameterError
+from facelib.mpeg4 import FAPU_SCALE, fap
 from facelib.tracking.headframe import HeadFrame
 
-__all__ = ["LipClosure", "close_lips", "closed_frames", "inner_lip_aperture",
+__all__ = ["LipClosure", "close_lips", "closed_frames", "closed_lip_columns", "inner_lip_aperture",
            "learn_threshold", "lip_closure"]
 
 _DATA = "tracking/lip_closure.json"
+_JAW, _UPPER, _LOWER = (fap(name).index for name in ("open_jaw", "lower_t_midlip",
+                                                      "raise_b_midlip"))
+"""Columns of FAPs 3, 4 and 5: the jaw and the inner lip midpoints the rule moves."""
 
 
 @dataclass(frozen=True)
@@ -105,22 +109,33 @@ def closed_frames(aperture: np.ndarray, *, close_below: float,
 def close_lips(values: np.ndarray, closed: np.ndarray, rule: LipClosure) -> np.ndarray:
     """``(n, 84)`` FAP values with the inner-lip separation of the ``closed`` ``(n,)``
     frames lowered to at most ``rule.closed_gap`` (FAPs 4, 5 and neighbours raised)."""
-    out = np.array(values, np.float64)
-    separation = rule.jaw_gain * out[:, 2] - out[:, 3] - out[:, 4]
+    values = np.array(values, np.float64)
+    separation = rule.jaw_gain * values[:, _JAW] - values[:, _UPPER] - values[:, _LOWER]
     raise_by = np.where(closed, np.maximum(separation - rule.closed_gap, 0.0) / 2, 0.0)
-    out[:, 3] += raise_by
-    out[:, 4] += raise_by
+    values[:, _UPPER] += raise_by
+    values[:, _LOWER] += raise_by
     for fap_id, share in rule.neighbours.items():
-        out[:, fap_id - 1] += share * raise_by
-    return out
+        values[:, fap_id - 1] += share * raise_by
+    return values
+
+
+def closed_lip_columns(rule: LipClosure) -> list[int]:
+    """The FAP columns :func:`close_lips` may change: FAPs 4, 5 and the rule's neighbours."""
+    return [_UPPER, _LOWER, *(f - 1 for f in rule.neighbours)]
 
 
 def learn_threshold(aperture: np.ndarray, is_open: np.ndarray, *,
                     false_closed: float = 0.15) -> float:
     """The aperture threshold under which only a ``false_closed`` share of the open frames
     (``is_open`` ``(n,) bool``: lips apart in truth) fall: the ``false_closed`` quantile of
-    their apertures ``(n,)``."""
-    a = np.asarray(aperture, np.float64)[np.asarray(is_open, bool)]
-    if not a.size:
-        raise ValueError("need open frames")
-    return float(np.quantile(a, false_closed))
+    their apertures ``(n,)``. ParameterError for mismatched shapes, no open frames or a
+    ``false_closed`` outside [0, 1]."""
+    share = check_number("false_closed", false_closed, low=0.0, high=1.0)
+    apertures = np.asarray(aperture, np.float64)
+    open_mask = np.asarray(is_open, bool)
+    if apertures.ndim != 1 or open_mask.shape != apertures.shape:
+        raise ParameterError(f"aperture {apertures.shape} and is_open {open_mask.shape} must "
+                             "be (n,) arrays of the same frames")
+    if not open_mask.any():
+        raise ParameterError(f"no open frames among the {len(apertures)} to learn from")
+    return float(np.quantile(apertures[open_mask], share))

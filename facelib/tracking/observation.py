@@ -41,10 +41,10 @@ from facelib.atomic import atomic_path
 from facelib.checks import check_count
 from facelib.data import path as data_path
 from facelib.errors import DataError, ParameterError, TrackingError
-from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, fap_table
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, fap_table
 from facelib.tracking.headframe import head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
-from facelib.tracking.pose import euler_angles
+from facelib.tracking.pose import HEAD_FAP_IDS, euler_angles
 
 __all__ = ["MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
            "learn_observation", "load_observation", "pose_correction", "save_observation",
@@ -102,9 +102,26 @@ def _normalised(landmarks: np.ndarray, neutral: int | tuple[int, int]
     frame = head_frame(data, layout=layout, span=neutral_span(neutral, len(data)))
     if frame.pose is None:
         raise TrackingError("the observation model needs a rigid head fit")
-    es = frame.fapu["ES"] * FAPU_SCALE
     angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
-    return (frame.landmarks - frame.rest)[..., :2] / es, frame.fapu, angles
+    return _over_es(frame.motion, frame.fapu), frame.fapu, angles
+
+
+def _over_es(displacements: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, L, 2)`` landmark displacements (the unit of ``fapu``) over the user's eye
+    separation ES0, same shape, float64."""
+    return np.asarray(displacements, np.float64) / (fapu["ES"] * FAPU_SCALE)
+
+
+def _model_input(model: ObservationModel, displacements: np.ndarray,
+                 fapu: Mapping[str, float]) -> np.ndarray:
+    """``(n, L * 2)`` the displacements ``(n, L, 2)`` over ES0, flattened as the model
+    reads them; ParameterError unless ``L`` is the model's landmark count."""
+    shape = np.shape(displacements)
+    n_land = model.estimator.shape[0]
+    if len(shape) != 3 or shape[1:] != (n_land, 2):
+        raise ParameterError(f"the observation model reads displacements (n, {n_land}, 2), "
+                             f"got {shape}")
+    return _over_es(displacements, fapu).reshape(shape[0], -1)
 
 
 def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
@@ -115,18 +132,27 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
 
     ``neutral``: the neutral frame(s); ``components``: principal components of the landmark
-    motion the regression uses (fewer than frames).
+    motion the regression uses (fewer than frames); ``faps``: the distinct FAP ids (1-84) to
+    learn. ParameterError when ``values`` is not one row of 84 FAPs per landmark frame.
     """
+    known = np.asarray(values, np.float64)
+    if known.shape != (len(landmarks), N_FAPS):
+        raise ParameterError(f"values must be ({len(landmarks)}, {N_FAPS}): the FAPs of each "
+                             f"landmark frame, got {known.shape}")
+    ids = np.asarray(faps, np.int64)
+    if ids.ndim != 1 or not ids.size or len(set(ids.tolist())) != ids.size or not (
+            (ids >= 1) & (ids <= N_FAPS)).all():
+        raise ParameterError(f"faps must be distinct FAP ids in 1-{N_FAPS}, got {faps!r}")
     moved, fapu, fitted = _normalised(landmarks, neutral)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
     if components > n - 2:
         raise ParameterError(f"{components} components need more than {components + 1} "
                              f"frames, got {n}")
-    ids = np.asarray(faps, np.int64)
-    truth = np.asarray(values, np.float64)[:, ids - 1]
+    truth = known[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
-    pose_error = np.asarray(values, np.float64)[:, 47:50] * ANGLE_UNIT - fitted
+    head = [f - 1 for f in HEAD_FAP_IDS]
+    pose_error = known[:, head] * ANGLE_UNIT - fitted
     target = np.hstack([target, pose_error])
     flat = moved.reshape(n, -1)
     centre = flat.mean(axis=0)
@@ -149,11 +175,11 @@ def solve_observation(model: ObservationModel, displacements: np.ndarray,
                       fapu: Mapping[str, float]) -> np.ndarray:
     """``(n, m) float64`` FAP values of ``model.faps`` from ``(n, L, 2)`` landmark
     displacements (neutral head frame, the unit of ``fapu``), each kept within
-    ``model.bounds``; 0 for a frame with no motion."""
-    es = fapu["ES"] * FAPU_SCALE
-    moved = np.asarray(displacements, np.float64).reshape(len(displacements), -1) / es
+    ``model.bounds``; 0 for a frame with no motion. ParameterError for another ``L`` than
+    the model's."""
+    moved = _model_input(model, displacements, fapu)
     found = moved @ model.estimator.reshape(moved.shape[1], -1)
-    found *= es / fap_lengths(model.faps, fapu)
+    found *= fapu["ES"] * FAPU_SCALE / fap_lengths(model.faps, fapu)
     return np.clip(found, model.bounds[:, 0], model.bounds[:, 1])
 
 
@@ -162,10 +188,9 @@ def pose_correction(model: ObservationModel, displacements: np.ndarray,
     """``(n, 3) float64`` correction (radians) to add to the fitted pitch, yaw and roll, from
     ``(n, L, 2)`` landmark displacements (neutral head frame, the unit of ``fapu``), within
     ``model.pose_bounds``; zeros for a model without one."""
-    n = len(displacements)
+    moved = _model_input(model, displacements, fapu)
     if model.pose is None or model.pose_bounds is None:
-        return np.zeros((n, 3))
-    moved = np.asarray(displacements, np.float64).reshape(n, -1) / (fapu["ES"] * FAPU_SCALE)
+        return np.zeros((len(moved), 3))
     found = moved @ model.pose.reshape(moved.shape[1], 3)
     return np.clip(found, model.pose_bounds[:, 0], model.pose_bounds[:, 1])
 
@@ -184,10 +209,13 @@ def save_observation(model: ObservationModel, path: str | os.PathLike[str]) -> P
     return Path(path)
 
 
-def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> ObservationModel:
+def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase, *,
+                     name: str | None = None) -> ObservationModel:
     """Read a model written by :func:`save_observation` (the pose arrays may be absent or
-    empty); DataError if it is malformed."""
-    where = str(source) if isinstance(source, (str, os.PathLike)) else _DATA
+    empty); DataError if it is malformed, naming ``name`` (default: the path, or
+    ``<stream>`` for an open stream)."""
+    if name is None:
+        name = str(source) if isinstance(source, (str, os.PathLike)) else "<stream>"
     try:
         with np.load(source, allow_pickle=False) as raw:
             arrays = {k: np.array(raw[k], np.float64) for k in ("faps", "estimator", "bounds")}
@@ -195,20 +223,30 @@ def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase) -> Obse
                 if key in raw.files and raw[key].size:
                     arrays[key] = np.array(raw[key], np.float64)
     except (OSError, KeyError, ValueError) as exc:
-        raise DataError(f"not an observation model ({exc})", path=where) from exc
-    m = len(arrays["faps"]) if arrays["faps"].ndim == 1 else -1
-    shape = arrays["estimator"].shape
-    pose_ok = len(shape) == 3 and (("pose" in arrays) == ("pose_bounds" in arrays)
-                                   and arrays.get("pose", np.zeros((shape[0], 2, 3))).shape
-                                   == (shape[0], 2, 3)
-                                   and arrays.get("pose_bounds", np.zeros((3, 2))).shape
-                                   == (3, 2))
-    if m < 0 or not pose_ok or shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
-        raise DataError("observation model arrays disagree in shape", path=where)
+        raise DataError(f"not an observation model ({exc})", path=name) from exc
+    if not _shapes_agree(arrays):
+        shapes = ", ".join(f"{k} {v.shape}" for k, v in arrays.items())
+        raise DataError(f"observation model arrays disagree in shape: {shapes} (want faps "
+                        "(m,), estimator (L, 2, m), bounds (m, 2) and, both or neither, pose "
+                        "(L, 2, 3) and pose_bounds (3, 2))", path=name)
     for value in arrays.values():
         value.flags.writeable = False
     return ObservationModel(arrays["faps"].astype(np.int64), arrays["estimator"],
                             arrays["bounds"], arrays.get("pose"), arrays.get("pose_bounds"))
+
+
+def _shapes_agree(arrays: Mapping[str, np.ndarray]) -> bool:
+    """Whether the arrays read by :func:`load_observation` fit :class:`ObservationModel`."""
+    faps, estimator = arrays["faps"], arrays["estimator"]
+    if faps.ndim != 1 or estimator.ndim != 3:
+        return False
+    m = len(faps)
+    if estimator.shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
+        return False
+    if ("pose" in arrays) != ("pose_bounds" in arrays):
+        return False
+    return "pose" not in arrays or (arrays["pose"].shape == (estimator.shape[0], 2, 3)
+                                    and arrays["pose_bounds"].shape == (3, 2))
 
 
 @cache
@@ -216,4 +254,4 @@ def default_observation() -> ObservationModel:
     """The packaged model: MediaPipe's 478 landmarks on the default head at 640x480
     (``facelib/data/tracking/observation_mediapipe.npz``)."""
     with data_path(_DATA).open("rb") as f:
-        return load_observation(io.BytesIO(f.read()))
+        return load_observation(io.BytesIO(f.read()), name=_DATA)

@@ -14,7 +14,12 @@ import numpy as np
 
 from facelib.errors import TrackingError
 
-__all__ = ["HeadPose", "euler_angles", "fit_pose", "refine_pose_2d", "unpose", "unpose_2d"]
+__all__ = ["HEAD_FAP_IDS", "HeadPose", "euler_angles", "fit_pose", "refine_pose_2d", "unpose",
+           "unpose_2d"]
+
+HEAD_FAP_IDS = (48, 49, 50)
+"""FAP ids (1-based; column = id - 1) of head pitch, yaw and roll, the order of
+:func:`euler_angles`. Not :data:`facelib.sync.combine.HEAD_FAPS`, which holds columns."""
 
 
 @dataclass(frozen=True)

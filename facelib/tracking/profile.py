@@ -30,16 +30,20 @@ import numpy as np
 
 from facelib.errors import FaceModelError
 
-__all__ = ["PROFILE_POINTS", "Profile", "midline_profile", "profile_points"]
+__all__ = ["PROFILE_NEEDS", "PROFILE_POINTS", "Profile", "midline_profile", "profile_points"]
 
 PROFILE_POINTS = ("9.3", "8.2", "2.1", "2.10")
 """Feature points :func:`profile_points` places from the profile."""
-_NEEDED = ("3.1", "3.2", "8.1", "8.2")  # what the fan's centre and the scale come from
+PROFILE_NEEDS = ("3.1", "3.2", "8.1", "8.2")
+"""Feature points :func:`profile_points` needs on both faces (the fan's centre and scale)."""
+_MIDLINE = ("8.1", "8.2", "2.2", "9.3", "2.1", "2.10")  # the median x of these is the plane
+_SOURCE_NEEDED = ("2.1", "2.10")  # the source's points whose normals are matched
 _BEHIND = 0.8  # the fan's centre lies this far (x the lid points' distance) behind the mouth
 _STEP = 1 / 120  # resampling step (x the same distance): about half a millimetre
 _CHORD = 4  # samples each side of the chord that gives the normal (about 2 mm)
 _LIP_WINDOW = 0.1  # the lower lip's upper face lies this far below the mouth line (x scale)
-_FAN_DEG = (45.0, -120.0, 661)  # from up-forward past straight down, in the y-z plane
+_FAN_DEG = (45.0, -120.0)  # the rays' angles, from up-forward past straight down (y-z plane)
+_FAN_RAYS = 661  # rays in the fan (a quarter of a degree apart)
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,7 +83,7 @@ def _cuts(vertices: np.ndarray, triangles: np.ndarray, x: float) -> np.ndarray:
 def _fan(cuts: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The last hit ``(m, 2)`` (y, z) of each fan ray from ``centre (2,)`` on the cut
     segments, and the rays' angles (radians) of those that hit."""
-    angles = np.radians(np.linspace(*_FAN_DEG[:2], int(_FAN_DEG[2])))
+    angles = np.radians(np.linspace(*_FAN_DEG, _FAN_RAYS))
     start, edge = cuts[:, 0] - centre, cuts[:, 1] - cuts[:, 0]
     hits, kept = [], []
     for angle in angles:
@@ -116,11 +120,17 @@ def midline_profile(vertices: np.ndarray, triangles: np.ndarray, *, x: float,
 
 
 def _profile_of(vertices: np.ndarray, triangles: np.ndarray,
-                points: Mapping[str, np.ndarray], x: float) -> Profile:
-    missing = [k for k in _NEEDED if k not in points]
+                points: Mapping[str, np.ndarray], *, whose: str = "") -> Profile:
+    """The profile of a mesh in its midline plane: the median ``x`` of its midline feature
+    points ``points`` (each ``(3,)``), nudged off a mirrored mesh's midline vertices by a
+    millionth of the lid points' distance. FaceModelError naming ``whose`` points are
+    missing."""
+    missing = [k for k in PROFILE_NEEDS if k not in points]
     if missing:
-        raise FaceModelError(f"the midline profile needs feature points {', '.join(missing)}")
-    scale = float(np.linalg.norm(points["3.1"] - points["3.2"]))
+        raise FaceModelError(f"the midline profile{whose} needs feature points "
+                             f"{', '.join(missing)}")
+    scale = float(np.linalg.norm(np.asarray(points["3.1"]) - np.asarray(points["3.2"])))
+    x = float(np.median([points[k][0] for k in _MIDLINE if k in points])) + 1e-6 * scale
     mouth = (np.asarray(points["8.1"]) + np.asarray(points["8.2"])) / 2
     centre = np.array([x, mouth[1], mouth[2] - _BEHIND * scale])
     return midline_profile(vertices, triangles, x=x, centre=centre, scale=scale)
@@ -142,24 +152,26 @@ def profile_points(vertices: np.ndarray, triangles: np.ndarray,
                    points: Mapping[str, np.ndarray], *,
                    source: tuple[np.ndarray, np.ndarray, Mapping[str, np.ndarray]]
                    ) -> dict[str, np.ndarray]:
-    """9.3, 2.1 and 2.10 placed on the midline profile of ``vertices (V, 3)``,
-    ``triangles (F, 3)`` (see the module docstring).
+    """9.3, 2.1, 2.10 and (where both faces have 2.2) 8.2 placed on the midline profile of
+    ``vertices (V, 3)``, ``triangles (F, 3)`` (see the module docstring).
 
     points: feature point -> (3,) positions found so far (3.1, 3.2, 8.1 and 8.2 are
         needed; the midline is the median ``x`` of the midline points among them).
-    source: the source face's vertices, triangles and feature point positions, whose own
-        profile gives the normal directions at 2.1 and 2.10 (its midline at the median x
-        of its midline points).
-    Returns the three points (the mesh's unit).
+    source: the source face's vertices, triangles and feature point positions (the same
+        four needed, and 2.1 and 2.10), whose own profile, made the same way, gives the
+        normal directions at 2.1, 2.10 and 8.2.
+    Returns point -> ``(3,)`` position (the mesh's unit). FaceModelError naming the missing
+    feature points.
     """
     src_vertices, src_triangles, src_points = source
-    mids = ("8.1", "8.2", "2.2", "9.3", "2.1", "2.10")
-    src_x = float(np.median([src_points[k][0] for k in mids if k in src_points]))
-    ref = _profile_of(src_vertices, src_triangles, src_points, _off_vertex(src_x, src_points))
+    missing = [k for k in _SOURCE_NEEDED if k not in src_points]
+    if missing:
+        raise FaceModelError(f"profile_points: the source face needs feature points "
+                             f"{', '.join(missing)}")
+    ref = _profile_of(src_vertices, src_triangles, src_points, whose=" of the source face")
     theta_21 = float(ref.theta[ref.nearest(np.asarray(src_points["2.1"]))])
     theta_210 = float(ref.theta[ref.nearest(np.asarray(src_points["2.10"]))])
-    x = float(np.median([points[k][0] for k in mids if k in points]))
-    profile = _profile_of(vertices, triangles, points, _off_vertex(x, points))
+    profile = _profile_of(vertices, triangles, points)
     chin, boss = _chin(profile, theta_21, theta_210)
     upper = np.flatnonzero(profile.points[:, 1] > points["8.1"][1])
     tip = upper[np.argmax(profile.points[upper, 2])] if upper.size else boss
@@ -180,9 +192,3 @@ def _lower_lip(profile: Profile, mouth: int, theta_82: float) -> int:
     while j < len(profile.theta) - 1 and profile.theta[j] > theta_82:
         j += 1
     return j
-
-
-def _off_vertex(x: float, points: Mapping[str, np.ndarray]) -> float:
-    """``x`` nudged by a millionth of the lid points' distance, so that the plane does not
-    run exactly through the vertices of a mirrored mesh's midline."""
-    return x + 1e-6 * float(np.linalg.norm(np.asarray(points["3.1"]) - points["3.2"]))

@@ -136,3 +136,16 @@ def test_mesh_with_bad_triangles(tmp_path: Path) -> None:
     np.savez(tmp_path / "default_head.npz", **arrays)
     with pytest.raises(FaceModelError, match="triangle index"):
         load_face(path)
+
+
+def test_integer_occlusion_is_read_into_the_unit_range(tmp_path: Path) -> None:
+    path = broken(tmp_path, lambda d: None)
+    with np.load(tmp_path / "default_head.npz") as data:
+        arrays = dict(data)
+    ao = np.full(len(arrays["vertices"]), 128, np.int16)
+    ao[:2] = (300, -5)  # outside 0-255: clipped like the colours, not past [0, 1]
+    arrays["vertex_ao"] = ao
+    np.savez(tmp_path / "default_head.npz", **arrays)
+    face = load_face(path)
+    assert face.vertex_ao is not None
+    np.testing.assert_allclose(face.vertex_ao[:3], [1.0, 0.0, 128 / 255], rtol=1e-6)

@@ -62,3 +62,11 @@ def test_an_unknown_framing_in_a_cue_is_refused(default_face):
     with pytest.raises(ParameterError, match="camera cue framing 'wide'"):
         render(_source((CameraCue("wide", 0),), 2), face=default_face, width=W, height=H,
                progress=False)
+
+
+def test_a_refused_cue_names_its_storyboard_line(default_face):
+    from facelib.rendering import render
+
+    cue = CameraCue("wide", 0, origin=("story.fdl", 7))
+    with pytest.raises(ParameterError, match=r"^story\.fdl:7: camera cue framing 'wide'"):
+        render(_source((cue,), 2), face=default_face, width=W, height=H, progress=False)

@@ -5,8 +5,10 @@ head (its MediaPipe-embedded vertices projected like a 640x480 camera)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from facelib.engine import default_face
+from facelib.errors import ParameterError
 from facelib.mpeg4 import N_FAPS, FapStream, fap
 from facelib.tracking.embedding import default_head_embedding
 from facelib.tracking.headframe import head_frame
@@ -74,3 +76,13 @@ def test_aperture_tells_pressed_from_open_lips():
     aperture = inner_lip_aperture(frame, lip_closure())
     assert aperture[4] > 0.1
     assert aperture[5] < lip_closure().close_below
+
+
+def test_learn_threshold_refuses_bad_input_with_a_parameter_error():
+    aperture = np.linspace(0.0, 0.1, 5)
+    with pytest.raises(ParameterError, match="no open frames"):
+        learn_threshold(aperture, np.zeros(5, bool))
+    with pytest.raises(ParameterError, match=r"aperture \(5,\) and is_open \(4,\)"):
+        learn_threshold(aperture, np.ones(4, bool))
+    with pytest.raises(ParameterError, match="false_closed"):
+        learn_threshold(aperture, np.ones(5, bool), false_closed=1.5)

@@ -4,6 +4,8 @@ default head deformed by known FAPs, its MediaPipe-embedded vertices projected l
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 import pytest
 
@@ -17,6 +19,7 @@ from facelib.tracking.observation import (
     default_observation,
     learn_observation,
     load_observation,
+    pose_correction,
     save_observation,
     solve_observation,
 )
@@ -145,3 +148,50 @@ def test_observed_needs_mediapipe_in_3d():
     with pytest.raises(ParameterError):
         learn_observation(camera(random_stream(6, seed=4)), random_stream(6, seed=4),
                           neutral=(0, 4), components=10)
+
+
+def test_load_names_the_arrays_that_disagree(tmp_path):
+    faps, estimator = np.array([3, 4]), np.zeros((478, 2, 2))
+    base = {"faps": faps, "estimator": estimator}
+    cases = {"bounds.npz": {**base, "bounds": np.zeros((3, 2))},  # 3 rows for 2 FAPs
+             "pose.npz": {**base, "bounds": np.zeros((2, 2)),  # pose without pose_bounds
+                          "pose": np.ones((478, 2, 3))}}
+    for name, arrays in cases.items():
+        np.savez(tmp_path / name, **arrays)
+        with pytest.raises(DataError, match=rf"{name}: observation model arrays disagree "
+                                            r"in shape: faps \(2,\), estimator \(478, 2, 2\)"):
+            load_observation(tmp_path / name)
+    np.savez(tmp_path / "good.npz", faps=faps, estimator=estimator, bounds=np.zeros((2, 2)),
+             pose=np.ones((478, 2, 3)), pose_bounds=np.zeros((3, 2)))
+    assert load_observation(tmp_path / "good.npz").pose is not None
+
+
+def test_learn_refuses_values_of_other_frames():
+    values = random_stream(60, seed=3)
+    with pytest.raises(ParameterError, match=r"values must be \(60, 84\).* got \(59, 84\)"):
+        learn_observation(camera(values), values[1:], neutral=(0, 4), faps=FAPS,
+                          components=10)
+
+
+def test_learn_refuses_fap_ids_outside_the_table():
+    values = random_stream(60, seed=3)
+    for bad in ((0, 3), (3, 85), (3, 3)):  # 0 read column -1 (FAP 84) without a word
+        with pytest.raises(ParameterError, match=r"faps must be distinct FAP ids in 1-84"):
+            learn_observation(camera(values), values, neutral=(0, 4), faps=bad,
+                              components=10)
+
+
+def test_solve_names_displacements_of_another_layout(learned):
+    fapu = {"ES": 1.0, "MNS": 1.0, "MW": 1.0, "ENS": 1.0, "IRISD": 1.0}
+    wrong = np.zeros((5, 468, 2))  # MediaPipe without the irises: the model reads 478
+    with pytest.raises(ParameterError, match=r"\(n, 478, 2\).* got \(5, 468, 2\)"):
+        solve_observation(learned, wrong, fapu)
+    with pytest.raises(ParameterError, match=r"\(n, 478, 2\).* got \(5, 468, 2\)"):
+        pose_correction(learned, wrong, fapu)
+
+
+def test_a_bad_stream_is_not_blamed_on_the_packaged_model():
+    with pytest.raises(DataError) as caught:
+        load_observation(io.BytesIO(b"not an npz"))
+    assert "observation_mediapipe" not in str(caught.value)
+    assert str(caught.value).startswith("<stream>: not an observation model")

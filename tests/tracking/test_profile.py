@@ -58,3 +58,14 @@ def test_the_profile_runs_down_the_face(source) -> None:  # type: ignore[no-unty
     with pytest.raises(FaceModelError, match=r"needs feature points 8\.1"):
         profile_points(vertices, triangles, {k: v for k, v in points.items() if k != "8.1"},
                        source=source)
+
+
+def test_missing_points_are_named(source) -> None:  # type: ignore[no-untyped-def]
+    vertices, triangles, points = source
+    without_lid = {k: v for k, v in points.items() if k != "3.1"}
+    with pytest.raises(FaceModelError, match=r"needs feature points 3\.1"):
+        profile_points(vertices, triangles, without_lid, source=source)
+    src_vertices, src_triangles, src_points = source
+    no_boss = {k: v for k, v in src_points.items() if k != "2.10"}
+    with pytest.raises(FaceModelError, match=r"source face .* 2\.10"):
+        profile_points(vertices, triangles, points, source=(src_vertices, src_triangles, no_boss))
