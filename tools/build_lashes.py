@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from facelib.engine.surface import segments_cross, vertex_normals
+
 ROOT = Path(__file__).resolve().parent.parent
 HEAD = ROOT / "facelib" / "data" / "head"
 SEED = 14
@@ -94,15 +96,6 @@ def lid_lines(pos, rim, centre, side_sign, upper_weights):
     low = ~up & (angle < LOWER_ANGLES[1]) & (angle > LOWER_ANGLES[0])
     lower = rim[low][np.argsort(-angle[low])]
     return upper, lower
-
-
-def vertex_normals(pos, tris):
-    """(V, 3) unit area-weighted vertex normals (outward for counter-clockwise triangles)."""
-    n = np.cross(pos[tris[:, 1]] - pos[tris[:, 0]], pos[tris[:, 2]] - pos[tris[:, 0]])
-    out = np.zeros_like(pos)
-    for k in range(3):
-        np.add.at(out, tris[:, k], n)
-    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
 
 
 def lashes_of_line(pos, normals, line, centre, *, lid, rng, scales):
@@ -221,7 +214,6 @@ def add_lashes(verts, tris, cols, doc, scales=None):
 
 def crossing_lashes(face, poses):
     """(n_lashes,) bool: lashes whose centre line passes through the skin in any pose."""
-    from facelib.engine.surface import segments_cross
 
     lash = face.parts["lashes"].vertex_ids
     skin = face.parts["skin"].triangles
