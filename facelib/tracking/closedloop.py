@@ -9,6 +9,7 @@ Needs the ``render`` and ``track`` extras.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -193,17 +194,17 @@ def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,
     shut = np.asarray(gap) < closed
     hits = [bool(shut[max(a - slack, 0): b + slack].any()) for a, b in events]
     if truth_gap is not None:
-        apart = np.asarray(truth_gap) >= closed
+        apart = closure_events((np.asarray(truth_gap) >= closed).astype(np.float64), 0.5)
         hits = [hit and _parts(shut, apart, a, b) for hit, (a, b) in zip(hits, events,
                                                                           strict=True)]
     return sum(hits) / len(events)
 
 
-def _parts(shut: np.ndarray, apart: np.ndarray, start: int, stop: int) -> bool:
-    """Whether ``shut`` ``(n,) bool`` is False somewhere in each run of ``apart`` frames
-    next to ``[start, stop)`` (runs at the ends of the clip included)."""
-    runs = closure_events(apart.astype(np.float64), 0.5)
-    near = [(a, b) for a, b in runs if b == start or a == stop]
+def _parts(shut: np.ndarray, apart: Sequence[tuple[int, int]], start: int, stop: int) -> bool:
+    """Whether ``shut`` ``(n,) bool`` is False somewhere in each run ``apart`` (the
+    ``[a, b)`` frame runs where the true lips are apart) next to ``[start, stop)`` (runs at
+    the ends of the clip included)."""
+    near = [(a, b) for a, b in apart if b == start or a == stop]
     return all((~shut[a:b]).any() for a, b in near)
 
 

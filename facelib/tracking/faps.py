@@ -233,7 +233,7 @@ def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
                  mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The closed mouth state (p, b, m) from MediaPipe's inner-lip aperture
     (:mod:`~facelib.tracking.lipclosure`) applied to ``values``; others pass unchanged."""
-    if layout.name != "mediapipe" or frame.landmarks.shape[1] < 468:
+    if layout.name != "mediapipe":
         return values, mask
     rule = lipclosure.lip_closure()
     closed = lipclosure.closed_frames(lipclosure.inner_lip_aperture(frame, rule),
