@@ -84,11 +84,11 @@ class ModernParts:
     camera: list[DraftCue] = field(default_factory=list)
 
 
-def _table(
+def table_of(
     arg: object, fn: str, ctx: Context, line: int | None, *, allowed: tuple[str, ...] | None
 ) -> LuaTable:
-    """``arg`` as a table; FdlError if it is not one or has a field outside ``allowed``
-    (None: any field)."""
+    """``arg``, the one table argument of a storyboard function, as a table; FdlError if it
+    is not one or has a field outside ``allowed`` (None: any field)."""
     if not isinstance(arg, LuaTable):
         raise FdlError(
             f'{fn} takes a table, like {fn} {{ "name", ... }}; got a {lua_kind(arg)} {arg!r}',
@@ -104,11 +104,6 @@ def _table(
                 line=line,
             )
     return arg
-
-
-table_of = _table
-"""``table_of(arg, fn, ctx, line, *, allowed)``: the one table argument of a storyboard
-function, its named fields checked (for readers outside this module)."""
 
 
 def _name(
@@ -145,7 +140,7 @@ def read_show(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
     """``show { "name", dur = ..., at, intensity, ease_in, ease_out }``: an expression."""
-    t = _table(arg, "show", ctx, line, allowed=fn.fields)
+    t = table_of(arg, "show", ctx, line, allowed=fn.fields)
     name = _name(t, "show", ctx, line, named="times and intensity (at = ..., dur = ...)")
     if "dur" not in t.fields:
         raise FdlError(f"show {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
@@ -188,7 +183,7 @@ def read_look(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
     """``look { "behaviour", args..., dur = ..., at }``: an eye behaviour."""
-    t = _table(arg, "look", ctx, line, allowed=fn.fields)
+    t = table_of(arg, "look", ctx, line, allowed=fn.fields)
     name = _name(t, "look", ctx, line)
     if "dur" not in t.fields:
         raise FdlError(f"look {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
@@ -226,7 +221,7 @@ def read_say(
     if isinstance(arg, str):
         parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
         return
-    t = _table(arg, "say", ctx, line, allowed=fn.fields)
+    t = table_of(arg, "say", ctx, line, allowed=fn.fields)
     f = t.fields
     first = t.items[0] if t.items else None
     if len(t.items) > 1 or (t.items and not isinstance(first, str)):
@@ -322,7 +317,7 @@ def read_define_expression(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
     """``define_expression { "name", FAP = value..., mix = {...} }``."""
-    t = _table(arg, "define_expression", ctx, line, allowed=fn.fields)
+    t = table_of(arg, "define_expression", ctx, line, allowed=fn.fields)
     name = _name(t, "define_expression", ctx, line,
                  named="FAP values (raise_l_cornerlip_o = 120)")
     valid = {f.name: f for f in fap_table() if f.kind != "special"}
@@ -405,7 +400,7 @@ def read_define_gaze(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
     """``define_gaze { "name", parameter = value... }``: an eye behaviour."""
-    t = _table(arg, "define_gaze", ctx, line, allowed=fn.fields)
+    t = table_of(arg, "define_gaze", ctx, line, allowed=fn.fields)
     name = _name(t, "define_gaze", ctx, line, named="parameters (rate = 2.0)")
     params: dict[str, Any] = {}
     for key, value in t.fields.items():
