@@ -48,6 +48,7 @@ __all__ = [
     "downsample",
     "frame_camera",
     "framing_points",
+    "install_program_cache",
     "load_look",
     "split_parts",
     "vertex_normals",
@@ -339,7 +340,7 @@ def _shader_file(name: str) -> str:
     return str(data.path(f"shaders/{name}"))
 
 
-def _install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
+def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
     """Give pyrender's ``renderer`` (a ``pyrender.Renderer``) facelib's program cache.
 
     It does two things. It serves facelib's face shader wherever pyrender asks for its
@@ -499,7 +500,7 @@ class FaceRenderer:
                 f"could not create a {scale * self.width}x{scale * self.height} offscreen "
                 f"OpenGL context ({type(exc).__name__}: {exc}); {INSTALL_HINT}"
             ) from exc
-        _install_program_cache(self._pr, renderer._renderer, self.look)
+        install_program_cache(self._pr, renderer._renderer, self.look)
         return renderer
 
     def _open(self, antialias: str) -> None:

@@ -21,7 +21,7 @@ from facelib.mpeg4.stream import FapStream
 from facelib.rendering.frames import face_or_default, stream_of
 from facelib.rendering.platform import import_pyrender
 from facelib.rendering.protocols import Deformable, HasFaps
-from facelib.rendering.scene import FaceRenderer, _install_program_cache
+from facelib.rendering.scene import FaceRenderer, install_program_cache
 
 __all__ = ["Playback", "has_display", "view"]
 
@@ -145,7 +145,7 @@ def view(
     except Exception as exc:
         raise RenderError(f"could not open a window ({type(exc).__name__}: {exc})") from exc
     with viewer.render_lock:  # shade with facelib's face shader, as offscreen frames are
-        _install_program_cache(pr, viewer._renderer, scene.look)
+        install_program_cache(pr, viewer._renderer, scene.look)
     # set after construction: pyrender's constructor only maps ASCII characters, the
     # property takes pyglet key symbols (arrows included)
     viewer.registered_keys = {**viewer.registered_keys, **_keys(state)}
