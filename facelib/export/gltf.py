@@ -19,7 +19,7 @@ import numpy as np
 
 from facelib import data
 from facelib.atomic import atomic_path
-from facelib.engine import Face, default_face
+from facelib.engine import Face, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import MissingExtraError, ParameterError
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
@@ -133,13 +133,8 @@ def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarra
 
 def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(V, 3) float32 unit area-weighted vertex normals ((0, 0, 1) where undefined)."""
-    v = vertices.astype(np.float64)
-    n = np.cross(v[triangles[:, 1]] - v[triangles[:, 0]], v[triangles[:, 2]] - v[triangles[:, 0]])
-    out = np.zeros_like(v)
-    for k in range(3):
-        np.add.at(out, triangles[:, k], n)
-    length = np.linalg.norm(out, axis=1, keepdims=True)
-    out = np.where(length > 0, out / np.where(length > 0, length, 1), [0.0, 0.0, 1.0])
+    out = surface.vertex_normals(vertices, triangles)
+    out[~out.any(axis=1)] = (0.0, 0.0, 1.0)
     return out.astype(np.float32)
 
 
