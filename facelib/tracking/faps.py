@@ -159,7 +159,8 @@ def default_rig() -> RigModel:
 
 
 def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
-    """One Euro filter on the measured columns, in FAPU0 distances and radians."""
+    """One Euro filter, both ways (no lag: the track is recorded), on the measured columns,
+    in FAPU0 distances and radians."""
     cols = np.flatnonzero(mask.any(axis=0))
     if not cols.size:
         return values
@@ -167,7 +168,7 @@ def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
                       for c in cols])
     params = _model()["one_euro"]
     smooth = one_euro(values[:, cols] * scale, fps=fps, min_cutoff=params["min_cutoff_hz"],
-                      beta=params["beta"], d_cutoff=params["d_cutoff_hz"])
+                      beta=params["beta"], d_cutoff=params["d_cutoff_hz"], causal=False)
     out = values.copy()
     out[:, cols] = smooth / scale
     return out

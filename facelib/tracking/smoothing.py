@@ -3,6 +3,12 @@
 A low-pass filter whose cutoff rises with the signal's speed: ``fc = min_cutoff + beta *
 |dx/dt|``. A still face keeps a low cutoff (no jitter); a blink or a lip closure moves fast,
 raises the cutoff and keeps its depth and timing.
+
+Run causally the filter lags behind fast motion by a frame or two (at 25 fps, speech's
+jaw loses about 0.03 of its correlation with the truth on the closed loop). A recorded track
+has its future too, so :func:`measure_faps <facelib.tracking.faps.measure_faps>` filters it
+both ways (``causal=False``): the mean of the forward pass and of the pass over the reversed
+track, whose lags are equal and opposite.
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ def _alpha(cutoff: np.ndarray | float, dt: float) -> np.ndarray:
 
 
 def one_euro(signal: np.ndarray, *, fps: float, min_cutoff: float = 4.0, beta: float = 1.0,
-             d_cutoff: float = 1.0) -> np.ndarray:
+             d_cutoff: float = 1.0, causal: bool = True) -> np.ndarray:
     """Filter ``(n_frames, C)`` signals sampled at ``fps``; returns ``(n_frames, C) float64``.
 
     Parameters
@@ -28,14 +34,19 @@ def one_euro(signal: np.ndarray, *, fps: float, min_cutoff: float = 4.0, beta: f
     min_cutoff: Hz, the cutoff of a still signal (> 0).
     beta: s per signal unit, how fast the cutoff rises with speed (>= 0).
     d_cutoff: Hz, the cutoff of the speed estimate (> 0).
-
-    The first frame passes unchanged; the filter is causal (usable live).
+    causal: filter forward only (usable live; the first frame passes unchanged); False
+        averages the forward pass and the backward one (no lag, for recorded tracks).
     """
     dt = 1.0 / check_fps(fps)
     min_cutoff = check_number("min_cutoff", min_cutoff, low=0, low_open=True)
     beta = check_number("beta", beta, low=0)
     d_cutoff = check_number("d_cutoff", d_cutoff, low=0, low_open=True)
     x = np.asarray(signal, np.float64)
+    if not causal:
+        forward = one_euro(x, fps=fps, min_cutoff=min_cutoff, beta=beta, d_cutoff=d_cutoff)
+        backward = one_euro(x[::-1], fps=fps, min_cutoff=min_cutoff, beta=beta,
+                            d_cutoff=d_cutoff)[::-1]
+        return 0.5 * (forward + backward)
     out = np.empty_like(x)
     if len(x) == 0:
         return out
