@@ -30,7 +30,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -87,7 +87,7 @@ class TrackedFaps:
 
 
 @cache
-def _model() -> dict[str, dict[str, float]]:
+def _model() -> dict[str, dict[str, Any]]:
     return json_data("tracking/model.json")
 
 
@@ -160,17 +160,21 @@ def default_rig() -> RigModel:
 
 def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     """One Euro filter, both ways (no lag: the track is recorded), on the measured columns,
-    in FAPU0 distances and radians."""
-    cols = np.flatnonzero(mask.any(axis=0))
-    if not cols.size:
-        return values
-    scale = np.array([ANGLE_UNIT if fap_table()[c].fapu == "AU" else 1 / FAPU_SCALE
-                      for c in cols])
+    in FAPU0 distances and radians; the jaw and lips with a higher still cutoff than the
+    rest (``model.json``)."""
     params = _model()["one_euro"]
-    smooth = one_euro(values[:, cols] * scale, fps=fps, min_cutoff=params["min_cutoff_hz"],
-                      beta=params["beta"], d_cutoff=params["d_cutoff_hz"], causal=False)
+    mouth = np.isin(np.arange(N_FAPS) + 1, params["mouth_faps"])
     out = values.copy()
-    out[:, cols] = smooth / scale
+    for group, cutoff in ((mouth, params["mouth_min_cutoff_hz"]),
+                          (~mouth, params["min_cutoff_hz"])):
+        cols = np.flatnonzero(mask.any(axis=0) & group)
+        if not cols.size:
+            continue
+        scale = np.array([ANGLE_UNIT if fap_table()[c].fapu == "AU" else 1 / FAPU_SCALE
+                          for c in cols])
+        out[:, cols] = one_euro(values[:, cols] * scale, fps=fps, min_cutoff=cutoff,
+                                beta=params["beta"], d_cutoff=params["d_cutoff_hz"],
+                                causal=False) / scale
     return out
 
 

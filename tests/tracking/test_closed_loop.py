@@ -31,8 +31,8 @@ from facelib.tracking.closedloop import (  # noqa: E402
 
 FLOORS = {3: 0.82, 6: 0.9, 7: 0.9, 12: 0.9, 13: 0.88, 19: 0.88, 20: 0.88, 23: 0.9, 24: 0.9}
 """open_jaw, lip corners (stretch 6/7, raise 12/13), upper lids, eyeball yaw. On these 110
-frames the default head measures 0.92, 0.98/0.97, 0.99/0.98, 0.97/0.96, 0.96/0.96 and the
-SOMA-X head 0.89, 0.98/0.98, 0.98/0.95, 0.94/0.94, 0.96/0.96 (the model trained with pushes
+frames the default head measures 0.93, 0.98/0.97, 0.99/0.97, 0.97/0.96, 0.96/0.96 and the
+SOMA-X head 0.89, 0.98/0.98, 0.98/0.95, 0.94/0.93, 0.96/0.96 (the model trained with pushes
 of a third of each FAP's reach, the One Euro filter run both ways)."""
 
 
@@ -71,7 +71,7 @@ def test_face_faps_follow_the_truth(loop):
     # units), so the corners are compared on the inner-lip FAPs 6/7 and 12/13
     found = {fap_id: round(loop.correlation(fap_id), 3) for fap_id in FLOORS}
     assert all(found[k] > v for k, v in FLOORS.items()), found
-    assert 0.6 < loop.gain(3) < 1.2       # open_jaw's amplitude comes back (0.76; 0.35 once)
+    assert 0.6 < loop.gain(3) < 1.2       # open_jaw's amplitude comes back (0.78; 0.35 once)
 
 
 def test_the_learned_model_beats_the_rig_fit(loop):
