@@ -15,10 +15,12 @@ up with ``facelib.setup_face``), which neither model has seen; the stylised cart
 with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise, worry,
 sadness, fear and anger, which move the brows visibly, and gaze) with head turns on the
 default head, as scripted on it, and with head turns on the SOMA-X and cartoon heads.
-Lip closures: the p/b/m closures of the truth (inner-lip gap under 0.1 MNS0 for at most
-0.4 s) during which the avatar's lips also touch, those after and before which they also
-part again (a closure held across several does not count), and the false closures (the
-avatar's lips touch where the source's do not).
+Lip closures: the p/b/m closures of the truth (its inner-lip gap under 0.1 MNS0 during a
+bilabial viseme of the storyboard) during which the avatar's lips also touch, those after
+and before which they also part again (a closure held across several does not count); the
+same for every brief lip contact of the truth (gap under 0.1 MNS0 for at most 0.4 s: p, b,
+m and the near-touches of other consonants); and the false closures (the avatar's lips
+touch where the source's do not).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import facelib
 from facelib.engine import Face, default_face
 from facelib.mpeg4 import FapStream
 from facelib.tracking.closedloop import (
+    bilabial_closures,
     closed_loop,
     closure_events,
     closure_recall,
@@ -49,7 +52,9 @@ FAPS = (3, 6, 7, 12, 13, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
 METHODS = ("observed", "default")
 
 
-def report(title: str, truth: FapStream, face: Face | None = None) -> None:
+def report(title: str, truth: FapStream, bilabial: list[tuple[int, int]],
+           face: Face | None = None) -> None:
+    """One clip: ``bilabial`` are the (start, end) ms of its p/b/m visemes."""
     started = time.perf_counter()
     loop = closed_loop(truth, face=face, keep_frames=True)
     print(f"\n{title}: {truth.n_frames} frames, closed loop in "
@@ -63,7 +68,8 @@ def report(title: str, truth: FapStream, face: Face | None = None) -> None:
         print(f"  {fap_id:>3}  {facelib.fap(fap_id).name:<22} {cells}")
     face = default_face() if face is None else face
     truth_gap = lip_gap(face, truth)
-    closures = lip_closures(truth_gap, truth.fps)
+    closures = (bilabial_closures(truth_gap, bilabial, truth.fps),
+                lip_closures(truth_gap, truth.fps))
     for method in METHODS:
         stream = found[method].stream
         blinks = [event_recall(closure_events(truth.values[:, f - 1], 600),
@@ -78,11 +84,13 @@ def report(title: str, truth: FapStream, face: Face | None = None) -> None:
     speed(loop.frames, loop.landmarks, truth.fps)
 
 
-def lips(closures: list[tuple[int, int]], truth_gap: np.ndarray, gap: np.ndarray) -> str:
-    return (f"lip closures (p/b/m) {len(closures)}: lips touch in "
-            f"{closure_recall(closures, gap):.0%}, touch and part again in "
-            f"{closure_recall(closures, gap, truth_gap=truth_gap):.0%}; "
-            f"false closures {false_closures(truth_gap, gap)}")
+def lips(closures: tuple[list[tuple[int, int]], ...], truth_gap: np.ndarray,
+         gap: np.ndarray) -> str:
+    cells = [f"{kind} {len(events)}: lips touch in {closure_recall(events, gap):.0%}, "
+             f"touch and part again in {closure_recall(events, gap, truth_gap=truth_gap):.0%}"
+             for kind, events in zip(("p/b/m closures", "all brief lip contacts"), closures,
+                                     strict=True)]
+    return "; ".join(cells) + f"; false closures {false_closures(truth_gap, gap)}"
 
 
 def correlation(truth: FapStream, found: FapStream, fap_id: int) -> float:
@@ -114,23 +122,26 @@ def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
 
 
 def main() -> None:
-    hello = facelib.run_fdl("examples/hello/hello.fdl").faps
-    report("hello.fdl with head turns (yaw 20, pitch 10, roll 8 degrees)",
-           with_head_turns(hello))
-    report("hello.fdl as scripted (small head motion)", hello)
+    hello, expressive = (facelib.run_fdl(f"examples/{name}.fdl")
+                         for name in ("hello/hello", "tracking/expressive"))
     soma = facelib.setup_face("examples/heads/soma_head.ply",
                               landmarks="examples/heads/soma_landmarks.json")
-    report("SOMA-X head, hello.fdl with head turns", with_head_turns(hello), soma)
-    report("SOMA-X head, hello.fdl as scripted", hello, soma)
     cartoon = facelib.setup_face("examples/heads/cartoon_head.obj",
                                  landmarks="examples/heads/cartoon_landmarks.json")
-    report("cartoon head, hello.fdl with head turns", with_head_turns(hello), cartoon)
-    expressive = facelib.run_fdl("examples/tracking/expressive.fdl").faps
-    report("expressive.fdl with head turns (brows: surprise, worry, sadness, fear, anger)",
-           with_head_turns(expressive))
-    report("expressive.fdl as scripted", expressive)
-    report("SOMA-X head, expressive.fdl with head turns", with_head_turns(expressive), soma)
-    report("cartoon head, expressive.fdl with head turns", with_head_turns(expressive), cartoon)
+    turns = "with head turns (yaw 20, pitch 10, roll 8 degrees)"
+    for title, run, face, turned in (
+            (f"hello.fdl {turns}", hello, None, True),
+            ("hello.fdl as scripted (small head motion)", hello, None, False),
+            ("SOMA-X head, hello.fdl with head turns", hello, soma, True),
+            ("SOMA-X head, hello.fdl as scripted", hello, soma, False),
+            ("cartoon head, hello.fdl with head turns", hello, cartoon, True),
+            ("expressive.fdl with head turns (brows: surprise, worry, sadness, fear, anger)",
+             expressive, None, True),
+            ("expressive.fdl as scripted", expressive, None, False),
+            ("SOMA-X head, expressive.fdl with head turns", expressive, soma, True),
+            ("cartoon head, expressive.fdl with head turns", expressive, cartoon, True)):
+        bilabial = [(v.start_ms, v.end_ms) for v in run.visemes if v.is_bilabial]
+        report(title, with_head_turns(run.faps) if turned else run.faps, bilabial, face)
 
 
 if __name__ == "__main__":

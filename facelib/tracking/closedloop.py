@@ -24,7 +24,8 @@ from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.pose import HEAD_FAP_IDS
 
-__all__ = ["LIPS_TOUCH", "ClosedLoop", "closed_loop", "closure_events", "closure_recall",
+__all__ = ["LIPS_TOUCH", "ClosedLoop", "bilabial_closures", "closed_loop", "closure_events",
+           "closure_recall",
            "event_recall", "false_closures", "lip_closures", "lip_gap", "with_head_turns",
            "with_neutral_lead"]
 
@@ -173,10 +174,23 @@ def lip_gap(face: Face, stream: FapStream) -> np.ndarray:
 def lip_closures(gap: np.ndarray, fps: float, *, closed: float = LIPS_TOUCH,
                  longest: float = 0.4) -> list[tuple[int, int]]:
     """Runs ``[start, stop)`` where the lips close (``gap`` below ``closed`` MNS0) for at
-    most ``longest`` seconds between open frames: the closures of p, b and m in speech
-    (rests between phrases are longer and are left out)."""
+    most ``longest`` seconds between open frames: the brief lip contacts of speech, those
+    of p, b and m and the near-touches of other consonants (rests between phrases are
+    longer and are left out). :func:`bilabial_closures` keeps those of p, b and m."""
     runs = closure_events(-np.asarray(gap), -closed)
     return [(a, b) for a, b in runs if a > 0 and b < len(gap) and (b - a) / fps <= longest]
+
+
+def bilabial_closures(gap: np.ndarray, spans_ms: Sequence[tuple[float, float]], fps: float, *,
+                      closed: float = LIPS_TOUCH) -> list[tuple[int, int]]:
+    """Runs ``[start, stop)`` where the true lips are shut for a p, b or m: the runs of
+    ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the true stream) under ``closed`` that overlap
+    one of ``spans_ms``, the ``(start, end)`` times in ms from the stream's first frame of
+    the storyboard's bilabial visemes (MPEG-4 viseme 1, ``VisemeSpan.is_bilabial``). A
+    closure that runs on into a pause counts once, whole."""
+    runs = closure_events(-np.asarray(gap), -closed)
+    spans = [(start * fps / 1000, end * fps / 1000) for start, end in spans_ms]
+    return [(a, b) for a, b in runs if any(a < end and start < b for start, end in spans)]
 
 
 def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,

@@ -43,6 +43,11 @@ class VisemeSpan:
     def is_silence(self) -> bool:
         return self.viseme == 0
 
+    @property
+    def is_bilabial(self) -> bool:
+        """MPEG-4 viseme 1 (p, b, m): the lips close."""
+        return self.viseme == 1
+
     def shifted(self, offset_ms: int) -> VisemeSpan:
         return replace(self, start_ms=self.start_ms + offset_ms, end_ms=self.end_ms + offset_ms)
 
