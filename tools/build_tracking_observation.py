@@ -16,8 +16,8 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
 3. :func:`facelib.tracking.observation.learn_observation` fits the observation model and
    it is written to ``facelib/data/tracking/observation_mediapipe.npz`` (the FAP estimator
    and the rigid pose fit's learned error); the closed-lips
-   threshold of :mod:`facelib.tracking.lipclosure` is learned from the random streams'
-   frames and written into ``facelib/data/tracking/lip_closure.json``.
+   threshold and open lips' gain of :mod:`facelib.tracking.lipclosure` are learned from the
+   random streams' frames and written into ``facelib/data/tracking/lip_closure.json``.
 4. With ``--validate``, the model is checked on a speech-like *validation* stream:
    storyboards made up here (the sentences below, random expressions and eye behaviours)
    animated by facelib, with slow random head sweeps (1226 frames, cached in
@@ -25,7 +25,8 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
    and the p/b/m closures are printed. Training choices (``--push``, the component count)
    are made on it, never on the closed-loop test streams. Nothing here shares anything
    with ``examples/hello/hello.fdl`` or ``examples/tracking/expressive.fdl``.
-   ``--no-write`` leaves the packaged files as they are (for comparing choices).
+   ``--no-write`` leaves the packaged files as they are (for comparing choices; the
+   validation then uses the packaged lip rule).
 
 Deterministic up to MediaPipe's and the renderer's own floating point.
 """
@@ -54,7 +55,13 @@ from facelib.tracking.closedloop import (
 from facelib.tracking.faps import measure_faps
 from facelib.tracking.headframe import fill_gaps, head_frame
 from facelib.tracking.layouts import landmark_layout
-from facelib.tracking.lipclosure import inner_lip_aperture, learn_threshold, lip_closure
+from facelib.tracking.lipclosure import (
+    inner_lip_aperture,
+    learn_open_gain,
+    learn_threshold,
+    lip_closure,
+    separation,
+)
 from facelib.tracking.observation import (
     MODEL_FAPS,
     ObservationModel,
@@ -226,10 +233,10 @@ def cached_track(stream: FapStream, cache: Path, fresh: bool) -> np.ndarray:
     return landmarks
 
 
-def write_closure_threshold(tracks: list[np.ndarray], streams: list[FapStream]) -> None:
-    """Learn the closed-lips threshold of :mod:`facelib.tracking.lipclosure` from the
-    training streams' frames (default head; open = true inner-lip gap at least 0.1 MNS0)
-    and write it into ``lip_closure.json``."""
+def write_lip_rule(tracks: list[np.ndarray], streams: list[FapStream]) -> None:
+    """Learn the closed-lips threshold and the open lips' gain of
+    :mod:`facelib.tracking.lipclosure` from the training streams' frames (default head;
+    open = true inner-lip gap at least 0.1 MNS0) and write them into ``lip_closure.json``."""
     rule = lip_closure()
     apertures, gaps = [], []
     for landmarks, stream in zip(tracks, streams, strict=True):
@@ -238,7 +245,9 @@ def write_closure_threshold(tracks: list[np.ndarray], streams: list[FapStream]) 
         apertures.append(inner_lip_aperture(frame, rule)[NEUTRAL:])
         gaps.append(lip_gap(default_face(), stream)[NEUTRAL:])
     aperture, gap = np.concatenate(apertures), np.concatenate(gaps)
+    true_separation = separation(np.concatenate([s.values[NEUTRAL:] for s in streams]), rule)
     threshold = round(learn_threshold(aperture, gap >= LIPS_TOUCH), 4)
+    gain = round(learn_open_gain(aperture, true_separation, aperture >= threshold))
     raw = json.loads(CLOSURE.read_text())
     n_open = int((gap >= LIPS_TOUCH).sum())
     source = (f"learned by tools/build_tracking_observation.py: 15 % of the {n_open} "
@@ -246,8 +255,14 @@ def write_closure_threshold(tracks: list[np.ndarray], streams: list[FapStream]) 
               f"head) have a smaller aperture; no hysteresis (open_above = close_below)")
     for key in ("close_below", "open_above"):
         raw[key] = {"value": threshold, "source": source}
+    n_above = int((aperture >= threshold).sum())
+    raw["open_gain"] = {"value": gain, "source": (
+        f"learned by tools/build_tracking_observation.py: least-squares slope through 0 of "
+        f"the true inner-lip separation (FAP units) on the aperture (MNS0) over the "
+        f"{n_above} training frames not in the closed state")}
     CLOSURE.write_text(json.dumps(raw, indent=2) + "\n")
-    print(f"wrote {CLOSURE.relative_to(ROOT)}: closed below an aperture of {threshold} MNS0")
+    print(f"wrote {CLOSURE.relative_to(ROOT)}: closed below an aperture of {threshold} MNS0, "
+          f"open at least {gain} FAP units per unit of aperture")
 
 
 def validate(model: ObservationModel, fresh: bool) -> None:
@@ -293,14 +308,14 @@ def main() -> None:
     print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL),
                               components=args.components)
+    if not args.no_write:
+        write_lip_rule(tracks, streams)
+        lip_closure.cache_clear()  # the validation reads the rule just written
+        save_observation(model, OUT)
+        print(f"wrote {OUT.relative_to(ROOT)}: {len(model.faps)} FAPs, "
+              f"{model.estimator.shape[0]} landmarks")
     if args.validate:
         validate(model, args.fresh)
-    if args.no_write:
-        return
-    write_closure_threshold(tracks, streams)
-    save_observation(model, OUT)
-    print(f"wrote {OUT.relative_to(ROOT)}: {len(model.faps)} FAPs, "
-          f"{model.estimator.shape[0]} landmarks")
 
 
 if __name__ == "__main__":

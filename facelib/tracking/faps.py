@@ -236,17 +236,19 @@ def _face_faps(frame: HeadFrame, layout: LandmarkLayout, span: slice, model: Mod
 
 def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
                  mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The closed mouth state (p, b, m) from MediaPipe's inner-lip aperture
-    (:mod:`~facelib.tracking.lipclosure`) applied to ``values``; others pass unchanged."""
+    """The mouth state from MediaPipe's inner-lip aperture (:mod:`~facelib.tracking.lipclosure`)
+    applied to ``values``: closed lips for p, b, m, at least the aperture's opening
+    elsewhere; other layouts pass unchanged."""
     if layout.name != "mediapipe":
         return values, mask
     rule = lipclosure.lip_closure()
-    closed = lipclosure.closed_frames(lipclosure.inner_lip_aperture(frame, rule),
-                                      close_below=rule.close_below,
+    aperture = lipclosure.inner_lip_aperture(frame, rule)
+    closed = lipclosure.closed_frames(aperture, close_below=rule.close_below,
                                       open_above=rule.open_above)
     mask = mask.copy()
     mask[:, lipclosure.closed_lip_columns(rule)] = True
-    return lipclosure.close_lips(values, closed, rule), mask
+    values = lipclosure.close_lips(values, closed, rule)
+    return lipclosure.open_lips(values, aperture, closed, rule), mask
 
 
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
@@ -302,7 +304,8 @@ def measure_faps(
         ``"observed"`` for 478 3-D MediaPipe landmarks and eq. 4.16 otherwise; None always
         uses eq. 4.16.
     close_lips: with a model (``rig`` not None) on MediaPipe landmarks, detect the closed
-        mouth of p, b and m from the inner-lip aperture and close the lips in those frames
+        mouth of p, b and m from the inner-lip aperture and close the lips in those frames,
+        and open them at least as far as the aperture shows in the others
         (:mod:`~facelib.tracking.lipclosure`).
     """
     rate = check_fps(fps)

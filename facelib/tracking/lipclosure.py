@@ -1,4 +1,5 @@
-"""The mouth's *closed* state (p, b, m) read off the inner-lip aperture.
+"""The mouth's *closed* state (p, b, m) and how far it is *open*, read off the inner-lip
+aperture.
 
 The learned observation model (:mod:`~facelib.tracking.observation`) recovers how far the
 mouth opens, but not the press of the lips past contact: MediaPipe's inner-lip landmarks
@@ -19,7 +20,11 @@ closed state in those frames:
    ``s = k_jaw f3 - f4 - f5`` (FAP units, MNS/1024), is lowered to at most the closed
    value ``closed_gap`` (the press of facelib's p/b/m viseme), by raising the inner lip
    FAPs 4 and 5 by equal amounts and their neighbours 8-11 in the viseme's proportion.
-   open_jaw is left alone.
+   open_jaw is left alone;
+4. in the other frames ``s`` is raised to at least ``open_gain a`` (the separation per unit
+   of aperture in the training renders' open frames, a least-squares fit through 0) by
+   lowering the same FAPs alike: the estimator and the smoothing shrink the quick openings
+   between two closures ("a baby"), which MediaPipe's inner-lip points still show.
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ from facelib.mpeg4 import FAPU_SCALE, fap
 from facelib.tracking.headframe import HeadFrame
 
 __all__ = ["LipClosure", "close_lips", "closed_frames", "closed_lip_columns", "inner_lip_aperture",
-           "learn_threshold", "lip_closure"]
+           "learn_open_gain", "learn_threshold", "lip_closure", "open_lips", "separation"]
 
 _DATA = "tracking/lip_closure.json"
 _JAW, _UPPER, _LOWER = (fap(name).index for name in ("open_jaw", "lower_t_midlip",
@@ -55,6 +60,7 @@ class LipClosure:
         closed state.
     jaw_gain: inner-lip separation per unit of open_jaw (FAP 3) in units of FAPs 4/5.
     closed_gap: the separation ``jaw_gain f3 - f4 - f5`` of the closed state (FAP units).
+    open_gain: the least separation (FAP units) per unit of aperture in open frames.
     neighbours: ``{fap_id: share}`` raised by ``share`` times the raise of 4 (upper lip)
         or 5 (lower lip).
     """
@@ -65,6 +71,7 @@ class LipClosure:
     open_above: float
     jaw_gain: float
     closed_gap: float
+    open_gain: float
     neighbours: dict[int, float]
 
 
@@ -76,7 +83,7 @@ def lip_closure() -> LipClosure:
         pairs = np.asarray(raw["inner_lip_pairs"], np.int64)
         rule = LipClosure(pairs[:, 0], pairs[:, 1], float(raw["close_below"]["value"]),
                           float(raw["open_above"]["value"]), float(raw["jaw_gain"]["value"]),
-                          float(raw["closed_gap"]["value"]),
+                          float(raw["closed_gap"]["value"]), float(raw["open_gain"]["value"]),
                           {int(k): float(v) for k, v in raw["neighbours"]["value"].items()})
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise DataError(f"malformed lip closure rule ({exc})", path=_DATA) from exc
@@ -106,21 +113,46 @@ def closed_frames(aperture: np.ndarray, *, close_below: float,
     return closed
 
 
-def close_lips(values: np.ndarray, closed: np.ndarray, rule: LipClosure) -> np.ndarray:
-    """``(n, 84)`` FAP values with the inner-lip separation of the ``closed`` ``(n,)``
-    frames lowered to at most ``rule.closed_gap`` (FAPs 4, 5 and neighbours raised)."""
+def separation(values: np.ndarray, rule: LipClosure) -> np.ndarray:
+    """``(n,)`` inner-lip separation ``jaw_gain f3 - f4 - f5`` (FAP units) of ``(n, 84)``
+    FAP values."""
+    values = np.asarray(values, np.float64)
+    return rule.jaw_gain * values[:, _JAW] - values[:, _UPPER] - values[:, _LOWER]
+
+
+def _close_by(values: np.ndarray, amount: np.ndarray, rule: LipClosure) -> np.ndarray:
+    """``(n, 84)`` values with the separation lowered by ``amount`` ``(n,)`` (negative:
+    raised): FAPs 4 and 5 raised by half of it each, their neighbours in the rule's
+    proportion."""
     values = np.array(values, np.float64)
-    separation = rule.jaw_gain * values[:, _JAW] - values[:, _UPPER] - values[:, _LOWER]
-    raise_by = np.where(closed, np.maximum(separation - rule.closed_gap, 0.0) / 2, 0.0)
-    values[:, _UPPER] += raise_by
-    values[:, _LOWER] += raise_by
+    half = np.asarray(amount, np.float64) / 2
+    values[:, _UPPER] += half
+    values[:, _LOWER] += half
     for fap_id, share in rule.neighbours.items():
-        values[:, fap_id - 1] += share * raise_by
+        values[:, fap_id - 1] += share * half
     return values
 
 
+def close_lips(values: np.ndarray, closed: np.ndarray, rule: LipClosure) -> np.ndarray:
+    """``(n, 84)`` FAP values with the inner-lip separation of the ``closed`` ``(n,)``
+    frames lowered to at most ``rule.closed_gap`` (FAPs 4, 5 and neighbours raised)."""
+    excess = np.maximum(separation(values, rule) - rule.closed_gap, 0.0)
+    return _close_by(values, np.where(closed, excess, 0.0), rule)
+
+
+def open_lips(values: np.ndarray, aperture: np.ndarray, closed: np.ndarray,
+              rule: LipClosure) -> np.ndarray:
+    """``(n, 84)`` FAP values with the inner-lip separation of the frames not ``closed``
+    ``(n,)`` raised to at least ``rule.open_gain`` times their ``aperture`` ``(n,)`` (MNS0)
+    (FAPs 4, 5 and neighbours lowered); never lowered."""
+    short = np.maximum(rule.open_gain * np.asarray(aperture, np.float64)
+                       - separation(values, rule), 0.0)
+    return _close_by(values, -np.where(closed, 0.0, short), rule)
+
+
 def closed_lip_columns(rule: LipClosure) -> list[int]:
-    """The FAP columns :func:`close_lips` may change: FAPs 4, 5 and the rule's neighbours."""
+    """The FAP columns :func:`close_lips` and :func:`open_lips` may change: FAPs 4, 5 and
+    the rule's neighbours."""
     return [_UPPER, _LOWER, *(f - 1 for f in rule.neighbours)]
 
 
@@ -139,3 +171,19 @@ def learn_threshold(aperture: np.ndarray, is_open: np.ndarray, *,
     if not open_mask.any():
         raise ParameterError(f"no open frames among the {len(apertures)} to learn from")
     return float(np.quantile(apertures[open_mask], share))
+
+
+def learn_open_gain(aperture: np.ndarray, true_separation: np.ndarray,
+                    is_open: np.ndarray) -> float:
+    """The least-squares slope through 0 of the ``true_separation`` ``(n,)`` of the inner
+    lips (FAP units, :func:`separation` of the true FAPs) on the ``aperture`` ``(n,)``
+    (MNS0) over the ``is_open`` ``(n,) bool`` frames. ParameterError for mismatched shapes
+    or no open frame with an aperture."""
+    a, s, mask = (np.asarray(x) for x in (aperture, true_separation, is_open))
+    if a.ndim != 1 or s.shape != a.shape or mask.shape != a.shape:
+        raise ParameterError(f"aperture {a.shape}, true_separation {s.shape} and is_open "
+                             f"{mask.shape} must be (n,) arrays of the same frames")
+    a, s = a[mask.astype(bool)].astype(np.float64), s[mask.astype(bool)].astype(np.float64)
+    if not (a * a).sum():
+        raise ParameterError("no open frame with a nonzero aperture to learn from")
+    return float((a * s).sum() / (a * a).sum())

@@ -17,8 +17,11 @@ from facelib.tracking.lipclosure import (
     close_lips,
     closed_frames,
     inner_lip_aperture,
+    learn_open_gain,
     learn_threshold,
     lip_closure,
+    open_lips,
+    separation,
 )
 
 PIXELS_PER_METRE = 1500.0
@@ -36,6 +39,8 @@ def test_packaged_rule():
     assert (np.concatenate([rule.upper, rule.lower]) < 468).all()
     assert 0.0 < rule.close_below <= rule.open_above < 0.2  # MNS0: under 3-4 mm
     assert rule.closed_gap < 0
+    # the open lips' gain: one MNS0 of MediaPipe's aperture is 1-4 MNS0 of true separation
+    assert 1024 < rule.open_gain < 4096
 
 
 def test_hysteresis():
@@ -59,6 +64,32 @@ def test_close_lips_lowers_the_separation_only_where_closed():
     np.testing.assert_allclose(out[:, 2], 200.0)  # open_jaw is left alone
     assert out[1, 3] == out[1, 4] > 0
     assert out[1, 7] == rule.neighbours[8] * out[1, 3]
+
+
+def test_open_lips_raises_the_separation_to_the_aperture_in_open_frames_only():
+    rule = lip_closure()
+    values = np.zeros((4, N_FAPS))
+    values[:, 2] = 100.0                       # open_jaw: separation 162 FAP units
+    aperture = np.array([0.2, 0.2, 0.01, 0.2])
+    closed = np.array([False, True, False, False])
+    values[3, [3, 4]] = -400.0                 # already wider open than the aperture asks
+    out = open_lips(values, aperture, closed, rule)
+    np.testing.assert_allclose(separation(out, rule)[0], rule.open_gain * 0.2)
+    np.testing.assert_allclose(out[1:], values[1:])   # closed, narrow, or already open
+    np.testing.assert_allclose(out[:, 2], 100.0)      # open_jaw is left alone
+    assert out[0, 3] == out[0, 4] < 0
+    assert out[0, 7] == rule.neighbours[8] * out[0, 3]
+
+
+def test_learn_open_gain_is_the_slope_through_zero_of_open_frames():
+    aperture = np.array([0.1, 0.2, 0.3, 0.0, 0.05])
+    true_separation = np.array([200.0, 400.0, 600.0, -141.0, 900.0])
+    is_open = np.array([True, True, True, False, False])
+    assert learn_open_gain(aperture, true_separation, is_open) == pytest.approx(2000.0)
+    with pytest.raises(ParameterError, match="no open frame"):
+        learn_open_gain(aperture, true_separation, np.zeros(5, bool))
+    with pytest.raises(ParameterError, match=r"true_separation \(4,\)"):
+        learn_open_gain(aperture, true_separation[:4], is_open)
 
 
 def test_learn_threshold_is_the_quantile_of_open_frames():
