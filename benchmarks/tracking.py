@@ -72,11 +72,11 @@ def report(title: str, truth: FapStream, bilabial: list[tuple[int, int]],
                 lip_closures(truth_gap, truth.fps))
     for method in METHODS:
         stream = found[method].stream
-        blinks = [event_recall(closure_events(truth.values[:, f - 1], 600),
-                               stream.values[:, f - 1]) for f in (19, 20)]
+        events = [closure_events(truth.values[:, f - 1], 600) for f in (19, 20)]
+        blinks = [event_recall(e, stream.values[:, f - 1])
+                  for e, f in zip(events, (19, 20), strict=True)]
         print(f"  {method}: blinks recalled (FAP 19, 20) {blinks[0]:.0%}, {blinks[1]:.0%} of "
-              f"{len(closure_events(truth.values[:, 18], 600))}; "
-              + lips(closures, truth_gap, lip_gap(face, stream)))
+              f"{len(events[0])}; " + lips(closures, truth_gap, lip_gap(face, stream)))
     plain = loop.remeasure(close_lips=False).stream
     print("  observed without the closed mouth state: "
           + lips(closures, truth_gap, lip_gap(face, plain)))

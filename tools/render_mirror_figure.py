@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 import facelib
-from facelib.mpeg4 import ANGLE_UNIT, FapStream
+from facelib.mpeg4 import ANGLE_UNIT, FapStream, fap
 from facelib.rendering.frames import render
 from facelib.rendering.video import save_png
 from facelib.tracking.closedloop import with_head_turns, with_neutral_lead
@@ -33,7 +33,7 @@ LEAD = 8
 """Neutral frames in front of the clip."""
 NEUTRAL = (0, 5)
 """The ``--neutral 0:5`` span given to tracking."""
-REPORTED = {3: "open_jaw", 12: "raise_l_cornerlip", 19: "close_t_l_eyelid", 49: "head_yaw"}
+REPORTED = ("open_jaw", "raise_l_cornerlip", "close_t_l_eyelid", "head_yaw")
 MAX_WIDTH = 1400
 
 
@@ -53,10 +53,11 @@ def pick_frames(truth: FapStream) -> dict[str, int]:
     widest open mouth (FAP 3) and the largest ``|head yaw|`` (FAP 49) among the frames
     where the lip corner is raised (FAP 12 above half its maximum)."""
     values = truth.values.astype(np.float64)
-    raise_corner = values[:, 11]
+    raise_corner = values[:, fap("raise_l_cornerlip").index]
     smiling = np.flatnonzero(raise_corner > 0.5 * raise_corner.max())
-    turned = smiling[np.argmax(np.abs(values[smiling, 48]))]
-    return {"blink": int(np.argmax(values[:, 18])), "open mouth": int(np.argmax(values[:, 2])),
+    turned = smiling[np.argmax(np.abs(values[smiling, fap("head_yaw").index]))]
+    return {"blink": int(np.argmax(values[:, fap("close_t_l_eyelid").index])),
+            "open mouth": int(np.argmax(values[:, fap("open_jaw").index])),
             "turned smile": int(turned)}
 
 
@@ -115,12 +116,13 @@ def main() -> None:
     save_png(compose(images), out)
     print(f"wrote {out}: {truth.n_frames} frames ({LEAD} neutral in front)")
     for what, i in picked.items():
-        yaw = np.degrees(truth.values[i, 48] * ANGLE_UNIT)
+        yaw = np.degrees(truth.values[i, fap("head_yaw").index] * ANGLE_UNIT)
         print(f"  {what}: frame {i} (clip frame {i - LEAD}, head yaw {yaw:+.1f} deg)")
-    for fap_id, name in REPORTED.items():
-        corr, gain = agreement(truth.values[LEAD:, fap_id - 1].astype(np.float64),
-                               found.stream.values[LEAD:, fap_id - 1].astype(np.float64))
-        print(f"  FAP {fap_id:>2} {name:<18} correlation {corr:.3f}  gain {gain:.2f}")
+    for name in REPORTED:
+        col = fap(name).index
+        corr, gain = agreement(truth.values[LEAD:, col].astype(np.float64),
+                               found.stream.values[LEAD:, col].astype(np.float64))
+        print(f"  FAP {col + 1:>2} {name:<18} correlation {corr:.3f}  gain {gain:.2f}")
 
 
 if __name__ == "__main__":

@@ -25,9 +25,8 @@ from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.pose import HEAD_FAP_IDS
 
 __all__ = ["LIPS_TOUCH", "ClosedLoop", "bilabial_closures", "closed_loop", "closure_events",
-           "closure_recall",
-           "event_recall", "false_closures", "lip_closures", "lip_gap", "with_head_turns",
-           "with_neutral_lead"]
+           "closure_recall", "event_recall", "false_closures", "lip_closures", "lip_gap",
+           "with_head_turns", "with_neutral_lead"]
 
 LIPS_TOUCH = 0.1
 """Inner-lip gap (:func:`lip_gap`, in MNS0) under which the lips count as touching."""
