@@ -3,7 +3,7 @@
 Usage (from the repository root; needs the ``render`` and ``track`` extras)::
 
     OMP_NUM_THREADS=1 python tools/build_tracking_observation.py [--frames 3000] [--seeds 9 10]
-        [--push 0.35] [--validate] [--no-write]
+        [--push 0.35] [--components 60] [--validate] [--no-write] [--fresh]
 
 1. Training streams are drawn at random (one per seed): every 3 frames a new face pose (a
    random viseme and expression of facelib's own libraries at random weights, plus independent
@@ -111,7 +111,10 @@ UPPER_LIDS = (-400.0, 500.0)
 """Range of the upper lids' FAPs 19 and 20 outside blinks (FAP units; negative raises): down
 to the raise of fear in facelib's library (-389)."""
 VALIDATION_SEED = 7
+"""Seed of the validation stream (its expressions, eye behaviours and head sweeps)."""
 VALIDATION_FAPS = (3, 6, 7, 12, 13, 31, 32, 19, 20, 21, 22, 23, 24, 48, 49, 50)
+"""The FAPs the validation prints: those of the closed loop's table (open_jaw, lip corners,
+inner brows, lids, eyeball yaw, head pitch, yaw and roll)."""
 NEUTRAL = 8
 FACE_STEP, HEAD_STEP = 3, 12
 EXTRA_FAPS = (18, 44, 45, 46, 63, 81, 82)
