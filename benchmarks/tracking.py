@@ -26,6 +26,7 @@ touch where the source's do not).
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -37,6 +38,8 @@ from facelib.tracking.closedloop import (
     closed_loop,
     closure_events,
     closure_recall,
+    curve_correlation,
+    curve_gain,
     event_recall,
     false_closures,
     lip_closures,
@@ -45,6 +48,7 @@ from facelib.tracking.closedloop import (
 )
 from facelib.tracking.faps import measure_faps
 from facelib.tracking.mediapipe import FaceMeshTracker
+from facelib.visemes.timeline import bilabial_spans
 
 FAPS = (3, 6, 7, 12, 13, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
 """The FAPs hello.fdl moves that the issue's closed loop names (lip corners: 6/7 and
@@ -52,7 +56,7 @@ FAPS = (3, 6, 7, 12, 13, 59, 60, 31, 32, 19, 20, 21, 22, 48, 49, 50, 23, 24)
 METHODS = ("observed", "default")
 
 
-def report(title: str, truth: FapStream, bilabial: list[tuple[int, int]],
+def report(title: str, truth: FapStream, bilabial: Sequence[tuple[float, float]],
            face: Face | None = None) -> None:
     """One clip: ``bilabial`` are the (start, end) ms of its p/b/m visemes."""
     started = time.perf_counter()
@@ -63,8 +67,10 @@ def report(title: str, truth: FapStream, bilabial: list[tuple[int, int]],
     print(f"  {'FAP':>3}  {'name':<22} " + " ".join(f"{m + ' corr':>13} {'gain':>5}"
                                                      for m in METHODS))
     for fap_id in FAPS:
-        cells = " ".join(f"{correlation(truth, found[m].stream, fap_id):13.3f} "
-                         f"{gain(truth, found[m].stream, fap_id):5.2f}" for m in METHODS)
+        true, col = truth.values[:, fap_id - 1], fap_id - 1
+        cells = " ".join(f"{curve_correlation(true, found[m].stream.values[:, col]):13.3f} "
+                         f"{curve_gain(true, found[m].stream.values[:, col]):5.2f}"
+                         for m in METHODS)
         print(f"  {fap_id:>3}  {facelib.fap(fap_id).name:<22} {cells}")
     face = default_face() if face is None else face
     truth_gap = lip_gap(face, truth)
@@ -78,7 +84,7 @@ def report(title: str, truth: FapStream, bilabial: list[tuple[int, int]],
         print(f"  {method}: blinks recalled (FAP 19, 20) {blinks[0]:.0%}, {blinks[1]:.0%} of "
               f"{len(events[0])}; " + lips(closures, truth_gap, lip_gap(face, stream)))
     plain = loop.remeasure(close_lips=False).stream
-    print("  observed without the closed mouth state: "
+    print("  observed without the mouth state: "
           + lips(closures, truth_gap, lip_gap(face, plain)))
     assert loop.frames is not None
     speed(loop.frames, loop.landmarks, truth.fps)
@@ -86,23 +92,14 @@ def report(title: str, truth: FapStream, bilabial: list[tuple[int, int]],
 
 def lips(closures: tuple[list[tuple[int, int]], ...], truth_gap: np.ndarray,
          gap: np.ndarray) -> str:
+    """One line on the p/b/m ``closures`` and the brief lip contacts (runs of frames) of
+    the true inner-lip ``truth_gap`` ``(n,)``: how many the recovered ``gap`` ``(n,)``
+    touches, touches and parts again, and its false closures."""
     cells = [f"{kind} {len(events)}: lips touch in {closure_recall(events, gap):.0%}, "
              f"touch and part again in {closure_recall(events, gap, truth_gap=truth_gap):.0%}"
              for kind, events in zip(("p/b/m closures", "all brief lip contacts"), closures,
                                      strict=True)]
     return "; ".join(cells) + f"; false closures {false_closures(truth_gap, gap)}"
-
-
-def correlation(truth: FapStream, found: FapStream, fap_id: int) -> float:
-    a, b = truth.values[:, fap_id - 1], found.values[:, fap_id - 1]
-    return float(np.corrcoef(a, b)[0, 1]) if a.std() > 0 and b.std() > 0 else float("nan")
-
-
-def gain(truth: FapStream, found: FapStream, fap_id: int) -> float:
-    a = truth.values[:, fap_id - 1].astype(np.float64)
-    b = found.values[:, fap_id - 1].astype(np.float64)
-    a = a - a.mean()
-    return float(a @ (b - b.mean()) / (a @ a)) if a @ a > 0 else float("nan")
 
 
 def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
@@ -140,8 +137,8 @@ def main() -> None:
             ("expressive.fdl as scripted", expressive, None, False),
             ("SOMA-X head, expressive.fdl with head turns", expressive, soma, True),
             ("cartoon head, expressive.fdl with head turns", expressive, cartoon, True)):
-        bilabial = [(v.start_ms, v.end_ms) for v in run.visemes if v.is_bilabial]
-        report(title, with_head_turns(run.faps) if turned else run.faps, bilabial, face)
+        report(title, with_head_turns(run.faps) if turned else run.faps,
+               bilabial_spans(run.visemes), face)
 
 
 if __name__ == "__main__":

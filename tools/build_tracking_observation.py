@@ -48,6 +48,8 @@ from facelib.tracking.closedloop import (
     LIPS_TOUCH,
     bilabial_closures,
     closure_recall,
+    curve_correlation,
+    curve_gain,
     false_closures,
     lip_closures,
     lip_gap,
@@ -69,6 +71,8 @@ from facelib.tracking.observation import (
     learn_observation,
     save_observation,
 )
+from facelib.tracking.pose import HEAD_FAP_IDS
+from facelib.visemes.timeline import bilabial_spans
 
 ROOT = Path(__file__).resolve().parent.parent
 CACHE = ROOT / "out" / "tracking_observation_training_{seed}.npz"
@@ -149,9 +153,11 @@ def face_pose(rng: np.random.Generator, reach: np.ndarray, poses: list[np.ndarra
     for lid in (19, 20):
         values[lid - 1] = rng.uniform(700, 1024) if blink else rng.uniform(*UPPER_LIDS)
     yaw, pitch = np.radians(rng.uniform(-28, 28)), np.radians(rng.uniform(-18, 18))
-    for eye in (0, 1):
-        values[22 + eye] = (yaw + np.radians(rng.uniform(-4, 4))) / ANGLE_UNIT
-        values[24 + eye] = (pitch + np.radians(rng.uniform(-3, 3))) / ANGLE_UNIT
+    for side in ("l", "r"):
+        values[fap(f"yaw_{side}_eyeball").index] = (yaw + np.radians(rng.uniform(-4, 4))
+                                                    ) / ANGLE_UNIT
+        values[fap(f"pitch_{side}_eyeball").index] = (pitch + np.radians(rng.uniform(-3, 3))
+                                                      ) / ANGLE_UNIT
     return values
 
 
@@ -198,12 +204,12 @@ def speech_stream(seed: int) -> tuple[FapStream, list[tuple[float, float]]]:
             story.write_text(f"fps = {FPS:g}\nseed = {seed + i}\n" + "\n".join(cues) + "\n")
             run = facelib.run_fdl(story)
             offset = sum(c.n_frames for c in clips) * 1000 / FPS
-            bilabial.extend((offset + v.start_ms, offset + v.end_ms) for v in run.visemes
-                            if v.is_bilabial)
+            bilabial.extend((offset + a, offset + b) for a, b in bilabial_spans(run.visemes))
             clips.append(run.faps)
     values = np.array(FapStream.concat(clips).values, np.float64)
     t = np.arange(len(values)) / FPS
-    for col, (low, high) in ((47, (3, 12)), (48, (5, 25)), (49, (3, 10))):
+    sweeps = ((3, 12), (5, 25), (3, 10))  # degrees: pitch, yaw, roll
+    for col, (low, high) in zip((f - 1 for f in HEAD_FAP_IDS), sweeps, strict=True):
         for _ in range(2):
             amplitude = np.radians(rng.uniform(low, high)) / 2 / ANGLE_UNIT
             values[:, col] += amplitude * np.sin(2 * np.pi * t / rng.uniform(2.5, 7.0)
@@ -276,17 +282,20 @@ def write_lip_rule(tracks: list[np.ndarray], streams: list[FapStream]) -> None:
 
 def validate(model: ObservationModel, fresh: bool) -> None:
     """Print how ``model`` recovers the validation stream (speech-like, head sweeps): the
-    correlation of each FAP of ``VALIDATION_FAPS`` and the p/b/m closures."""
+    correlation of each FAP of ``VALIDATION_FAPS``, the inner-lip gap and the p/b/m
+    closures."""
     stream, bilabial = speech_stream(VALIDATION_SEED)
     landmarks = cached_track(stream, VALIDATION_CACHE, fresh)
     found = measure_faps(landmarks, fps=FPS, neutral=(0, NEUTRAL), rig=model).stream[NEUTRAL:]
     truth = stream[NEUTRAL:]
-    cells = [f"{f} {np.corrcoef(truth.values[:, f - 1], found.values[:, f - 1])[0, 1]:.3f}"
-             for f in VALIDATION_FAPS]
-    print("validation stream, correlation per FAP: " + ", ".join(cells))
-    mean = np.mean([float(c.split()[1]) for c in cells])
-    print(f"  mean correlation {mean:.3f}")
+    r = np.array([curve_correlation(truth.values[:, f - 1], found.values[:, f - 1])
+                  for f in VALIDATION_FAPS])
+    print("validation stream, correlation per FAP: "
+          + ", ".join(f"{f} {c:.3f}" for f, c in zip(VALIDATION_FAPS, r, strict=True)))
+    print(f"  mean correlation {r.mean():.3f}")
     truth_gap, gap = lip_gap(default_face(), truth), lip_gap(default_face(), found)
+    print(f"  inner-lip gap: correlation {curve_correlation(truth_gap, gap):.3f}, gain "
+          f"{curve_gain(truth_gap, gap):.2f}")
     for kind, closures in (("p/b/m closures", bilabial_closures(truth_gap, bilabial, FPS)),
                            ("all brief lip contacts", lip_closures(truth_gap, FPS))):
         parted = closure_recall(closures, gap, truth_gap=truth_gap) * len(closures)

@@ -24,7 +24,12 @@ import facelib
 from facelib.mpeg4 import ANGLE_UNIT, FapStream, fap
 from facelib.rendering.frames import render
 from facelib.rendering.video import save_png
-from facelib.tracking.closedloop import with_head_turns, with_neutral_lead
+from facelib.tracking.closedloop import (
+    curve_correlation,
+    curve_gain,
+    with_head_turns,
+    with_neutral_lead,
+)
 from facelib.tracking.mirror import render_mirror
 from facelib.tracking.video import read_video, track_video_faps
 
@@ -61,14 +66,6 @@ def pick_frames(truth: FapStream) -> dict[str, int]:
             "turned smile": int(turned)}
 
 
-def agreement(truth: np.ndarray, found: np.ndarray) -> tuple[float, float]:
-    """Pearson correlation and least-squares gain (slope) of ``found`` on ``truth``
-    (both ``(n,)``)."""
-    a = truth - truth.mean()
-    b = found - found.mean()
-    return float(np.corrcoef(a, b)[0, 1]), float((a @ b) / (a @ a))
-
-
 def mirror_images(mirror: Path, frames: list[int]) -> list[np.ndarray]:
     """The ``(H, W, 3) uint8`` frames ``frames`` of the video ``mirror``, in that order."""
     _, images = read_video(mirror)
@@ -81,11 +78,14 @@ def mirror_images(mirror: Path, frames: list[int]) -> list[np.ndarray]:
 
 def zoom_source(image: np.ndarray, points: np.ndarray) -> np.ndarray:
     """A mirror frame ``(H, 2W, 3)`` with its source half (left) cropped to half size around
-    the bounding box of the frame's landmarks ``points`` ``(478, 3)`` pixels and enlarged
-    2x (nearest pixel), so the face and its landmark dots show at the avatar's scale."""
+    the bounding box of the frame's landmarks ``points`` ``(478, 3)`` pixels (the image's
+    centre in a frame without a face) and enlarged 2x (nearest pixel), so the face and its
+    landmark dots show at the avatar's scale."""
     height, width = image.shape[0], image.shape[1] // 2
     box_h, box_w = height // 2, width // 2
-    centre = (np.nanmin(points[:, :2], axis=0) + np.nanmax(points[:, :2], axis=0)) / 2
+    seen = points[np.isfinite(points[:, :2]).all(axis=1), :2]
+    centre = ((seen.min(axis=0) + seen.max(axis=0)) / 2 if len(seen)
+              else np.array([width / 2, height / 2]))
     left = int(np.clip(round(centre[0]) - box_w // 2, 0, width - box_w))
     top = int(np.clip(round(centre[1]) - box_h // 2, 0, height - box_h))
     crop = image[top: top + box_h, left: left + box_w]
@@ -120,8 +120,8 @@ def main() -> None:
         print(f"  {what}: frame {i} (clip frame {i - LEAD}, head yaw {yaw:+.1f} deg)")
     for name in REPORTED:
         col = fap(name).index
-        corr, gain = agreement(truth.values[LEAD:, col].astype(np.float64),
-                               found.stream.values[LEAD:, col].astype(np.float64))
+        true, seen = truth.values[LEAD:, col], found.stream.values[LEAD:, col]
+        corr, gain = curve_correlation(true, seen), curve_gain(true, seen)
         print(f"  FAP {col + 1:>2} {name:<18} correlation {corr:.3f}  gain {gain:.2f}")
 
 

@@ -9,6 +9,7 @@ Needs the ``render`` and ``track`` extras.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -25,8 +26,8 @@ from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.pose import HEAD_FAP_IDS
 
 __all__ = ["LIPS_TOUCH", "ClosedLoop", "bilabial_closures", "closed_loop", "closure_events",
-           "closure_recall", "event_recall", "false_closures", "lip_closures", "lip_gap",
-           "with_head_turns", "with_neutral_lead"]
+           "closure_recall", "curve_correlation", "curve_gain", "event_recall",
+           "false_closures", "lip_closures", "lip_gap", "with_head_turns", "with_neutral_lead"]
 
 LIPS_TOUCH = 0.1
 """Inner-lip gap (:func:`lip_gap`, in MNS0) under which the lips count as touching."""
@@ -64,20 +65,30 @@ class ClosedLoop:
         return _trim(found, k)
 
     def correlation(self, fap_id: int) -> float:
-        """Pearson correlation of the true and recovered curves of FAP ``fap_id`` (NaN if
-        either is constant)."""
-        a = self.truth.values[:, fap_id - 1].astype(np.float64)
-        b = self.tracked.stream.values[:, fap_id - 1].astype(np.float64)
-        if a.std() == 0 or b.std() == 0:
-            return float("nan")
-        return float(np.corrcoef(a, b)[0, 1])
+        """:func:`curve_correlation` of the true and recovered curves of FAP ``fap_id``."""
+        return curve_correlation(self.truth.values[:, fap_id - 1],
+                                 self.tracked.stream.values[:, fap_id - 1])
 
     def gain(self, fap_id: int) -> float:
-        """Least-squares slope of recovered on true values (1 = right amplitude)."""
-        a = self.truth.values[:, fap_id - 1].astype(np.float64)
-        b = self.tracked.stream.values[:, fap_id - 1].astype(np.float64)
-        a = a - a.mean()
-        return float((a @ (b - b.mean())) / (a @ a)) if a @ a > 0 else float("nan")
+        """:func:`curve_gain` of the recovered curve of FAP ``fap_id`` on the true one."""
+        return curve_gain(self.truth.values[:, fap_id - 1],
+                          self.tracked.stream.values[:, fap_id - 1])
+
+
+def curve_correlation(truth: np.ndarray, found: np.ndarray) -> float:
+    """Pearson correlation of two ``(n,)`` curves; NaN if either is constant."""
+    a, b = np.asarray(truth, np.float64), np.asarray(found, np.float64)
+    if a.std() == 0 or b.std() == 0:
+        return float("nan")
+    return float(np.corrcoef(a, b)[0, 1])
+
+
+def curve_gain(truth: np.ndarray, found: np.ndarray) -> float:
+    """Least-squares slope of the ``(n,)`` curve ``found`` on ``truth`` (1 = the right
+    amplitude); NaN if ``truth`` is constant."""
+    a, b = np.asarray(truth, np.float64), np.asarray(found, np.float64)
+    a = a - a.mean()
+    return float((a @ (b - b.mean())) / (a @ a)) if a @ a > 0 else float("nan")
 
 
 def with_head_turns(stream: FapStream, *, frames: int | None = None) -> FapStream:
@@ -185,11 +196,15 @@ def bilabial_closures(gap: np.ndarray, spans_ms: Sequence[tuple[float, float]], 
     """Runs ``[start, stop)`` where the true lips are shut for a p, b or m: the runs of
     ``gap`` ``(n,)`` (MNS0, :func:`lip_gap` of the true stream) under ``closed`` that overlap
     one of ``spans_ms``, the ``(start, end)`` times in ms from the stream's first frame of
-    the storyboard's bilabial visemes (MPEG-4 viseme 1, ``VisemeSpan.is_bilabial``). A
-    closure that runs on into a pause counts once, whole."""
+    the storyboard's bilabial visemes (``facelib.visemes.timeline.bilabial_spans``): a
+    closure overlaps a span when one of its frames (frame ``i`` at ``1000 i / fps`` ms)
+    falls in it. A closure that runs on into a pause counts once, whole; one cut by the
+    clip's start or end counts too (whether the lips part is then checked on its other
+    side only)."""
     runs = closure_events(-np.asarray(gap), -closed)
-    spans = [(start * fps / 1000, end * fps / 1000) for start, end in spans_ms]
-    return [(a, b) for a, b in runs if any(a < end and start < b for start, end in spans)]
+    frames = [(math.ceil(start * fps / 1000), math.ceil(end * fps / 1000))
+              for start, end in spans_ms]
+    return [(a, b) for a, b in runs if any(a < last and first < b for first, last in frames)]
 
 
 def closure_recall(events: list[tuple[int, int]], gap: np.ndarray, *,

@@ -36,7 +36,7 @@ import numpy as np
 
 from facelib.checks import check_fps
 from facelib.data import json_data
-from facelib.errors import ParameterError, TrackingError, TrackingWarning
+from facelib.errors import DataError, ParameterError, TrackingError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
 from facelib.tracking import lipclosure
 from facelib.tracking.headframe import (
@@ -159,22 +159,26 @@ def default_rig() -> RigModel:
 
 
 def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
-    """One Euro filter, both ways (no lag: the track is recorded), on the measured columns,
-    in FAPU0 distances and radians; the jaw and lips with a higher still cutoff than the
-    rest (``model.json``)."""
+    """``(n, 84)`` ``values`` with the One Euro filter run both ways (no lag: the track is
+    recorded) over the columns ``mask`` ``(n, 84)`` measures, in FAPU0 distances and
+    radians; the jaw and lips with a higher still cutoff than the rest (``model.json``)."""
     params = _model()["one_euro"]
-    mouth = np.isin(np.arange(N_FAPS) + 1, params["mouth_faps"])
+    try:
+        mouth = np.isin(np.arange(N_FAPS) + 1, params["mouth_faps"])
+        cutoffs = (float(params["mouth_min_cutoff_hz"]), float(params["min_cutoff_hz"]))
+        beta, d_cutoff = float(params["beta"]), float(params["d_cutoff_hz"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DataError(f"malformed one_euro parameters ({exc})",
+                        path="tracking/model.json") from exc
     out = values.copy()
-    for group, cutoff in ((mouth, params["mouth_min_cutoff_hz"]),
-                          (~mouth, params["min_cutoff_hz"])):
+    for group, cutoff in zip((mouth, ~mouth), cutoffs, strict=True):
         cols = np.flatnonzero(mask.any(axis=0) & group)
         if not cols.size:
             continue
         scale = np.array([ANGLE_UNIT if fap_table()[c].fapu == "AU" else 1 / FAPU_SCALE
                           for c in cols])
         out[:, cols] = one_euro(values[:, cols] * scale, fps=fps, min_cutoff=cutoff,
-                                beta=params["beta"], d_cutoff=params["d_cutoff_hz"],
-                                causal=False) / scale
+                                beta=beta, d_cutoff=d_cutoff, causal=False) / scale
     return out
 
 
@@ -254,15 +258,16 @@ def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
             states: Mapping[str, np.ndarray] | None, relations: bool,
             lips: tuple[HeadFrame, LandmarkLayout] | None) -> tuple[np.ndarray, np.ndarray]:
-    """Smoothing, the closed lips of p/b/m (``lips``: where to read them), the floor of
-    unidirectional FAPs, then eq. 4.17."""
+    """Smoothing, the floor of unidirectional FAPs, the mouth state (closed for p/b/m, at
+    least the aperture's opening elsewhere; ``lips``: where to read it), then eq. 4.17.
+    ``values`` and ``mask`` are ``(n, 84)``."""
     if smooth:
         values = _smooth(values, mask, rate)
-    if lips is not None:
-        values, mask = _closed_lips(*lips, values, mask)
     for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
         if fap.bidirectional is False and fap.min == 0:
             values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
+    if lips is not None:  # after the floor: the lip separation counts open_jaw as shown
+        values, mask = _closed_lips(*lips, values, mask)
     if relations or states:
         values, mask = apply_relations(values, mask, frame_states=states)
     return values, mask
@@ -303,10 +308,10 @@ def measure_faps(
         landmarks (needs the ``mediapipe`` layout); ``"auto"`` (the default) is
         ``"observed"`` for 478 3-D MediaPipe landmarks and eq. 4.16 otherwise; None always
         uses eq. 4.16.
-    close_lips: with a model (``rig`` not None) on MediaPipe landmarks, detect the closed
-        mouth of p, b and m from the inner-lip aperture and close the lips in those frames,
-        and open them at least as far as the aperture shows in the others
-        (:mod:`~facelib.tracking.lipclosure`).
+    close_lips: with a model (``rig`` not None) on MediaPipe landmarks, apply the mouth
+        state read off the inner-lip aperture (:mod:`~facelib.tracking.lipclosure`): close
+        the lips in the frames of a p, b or m and open them at least as far as the
+        aperture shows in the others. False turns both off.
     """
     rate = check_fps(fps)
     data, layout, model = _inputs(landmarks, layout, rig)

@@ -21,10 +21,11 @@ closed state in those frames:
    value ``closed_gap`` (the press of facelib's p/b/m viseme), by raising the inner lip
    FAPs 4 and 5 by equal amounts and their neighbours 8-11 in the viseme's proportion.
    open_jaw is left alone;
-4. in the other frames ``s`` is raised to at least ``open_gain a`` (the separation per unit
-   of aperture in the training renders' open frames, a least-squares fit through 0) by
-   lowering the same FAPs alike: the estimator and the smoothing shrink the quick openings
-   between two closures ("a baby"), which MediaPipe's inner-lip points still show.
+4. in the other frames ``s`` is raised to at least ``open_gain a`` by lowering the same FAPs
+   alike, ``open_gain`` being the least-squares slope through 0 of the true separation on
+   the aperture over the training renders' frames not in the closed state: the estimator
+   and the smoothing shrink the quick openings between two closures ("a baby"), which
+   MediaPipe's inner-lip points still show.
 """
 
 from __future__ import annotations
@@ -60,7 +61,8 @@ class LipClosure:
         closed state.
     jaw_gain: inner-lip separation per unit of open_jaw (FAP 3) in units of FAPs 4/5.
     closed_gap: the separation ``jaw_gain f3 - f4 - f5`` of the closed state (FAP units).
-    open_gain: the least separation (FAP units) per unit of aperture in open frames.
+    open_gain: FAP units of separation per MNS0 of aperture, used as a floor outside the
+        closed state (a least-squares slope learned from the training renders).
     neighbours: ``{fap_id: share}`` raised by ``share`` times the raise of 4 (upper lip)
         or 5 (lower lip).
     """
@@ -184,6 +186,8 @@ def learn_open_gain(aperture: np.ndarray, true_separation: np.ndarray,
         raise ParameterError(f"aperture {a.shape}, true_separation {s.shape} and is_open "
                              f"{mask.shape} must be (n,) arrays of the same frames")
     a, s = a[mask.astype(bool)].astype(np.float64), s[mask.astype(bool)].astype(np.float64)
+    if not (np.isfinite(a).all() and np.isfinite(s).all()):
+        raise ParameterError("aperture and true_separation must be finite in the open frames")
     if not (a * a).sum():
         raise ParameterError("no open frame with a nonzero aperture to learn from")
     return float((a * s).sum() / (a * a).sum())

@@ -3,6 +3,7 @@ viseme spans made from them, in integer milliseconds."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from facelib.errors import ParameterError
@@ -16,7 +17,7 @@ from facelib.speech.timeline import (
 )
 
 __all__ = ["SILENCE", "Alphabet", "PhoneTimeline", "Source", "Span", "SpeechTimeline",
-           "VisemeSpan"]
+           "VisemeSpan", "bilabial_spans"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,6 +51,12 @@ class VisemeSpan:
 
     def shifted(self, offset_ms: int) -> VisemeSpan:
         return replace(self, start_ms=self.start_ms + offset_ms, end_ms=self.end_ms + offset_ms)
+
+
+def bilabial_spans(visemes: Sequence[VisemeSpan] | None) -> list[tuple[int, int]]:
+    """``(start_ms, end_ms)`` of the p, b and m visemes among ``visemes`` (an animation's
+    viseme track; None, an animation without speech, has none)."""
+    return [(v.start_ms, v.end_ms) for v in visemes or () if v.is_bilabial]
 
 
 @dataclass(frozen=True, slots=True)

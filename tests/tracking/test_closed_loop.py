@@ -29,6 +29,7 @@ from facelib.tracking.closedloop import (  # noqa: E402
     lip_gap,
     with_head_turns,
 )
+from facelib.visemes.timeline import bilabial_spans  # noqa: E402
 
 FLOORS = {3: 0.82, 6: 0.9, 7: 0.9, 12: 0.9, 13: 0.88, 19: 0.88, 20: 0.88, 21: 0.88, 22: 0.88,
           23: 0.9, 24: 0.9}
@@ -111,8 +112,7 @@ def test_lip_closures_come_back(which, hello, loop, soma_loop):
     # closures
     found, face = (loop, default_face()) if which == "default" else (soma_loop, soma_face())
     truth_gap = lip_gap(face, found.truth)
-    bilabial = [(v.start_ms, v.end_ms) for v in hello.visemes if v.is_bilabial]
-    pbm = bilabial_closures(truth_gap, bilabial, found.truth.fps)
+    pbm = bilabial_closures(truth_gap, bilabial_spans(hello.visemes), found.truth.fps)
     contacts = lip_closures(truth_gap, found.truth.fps)
     assert len(pbm) == 3 and len(contacts) >= 3
 

@@ -7,9 +7,12 @@ import numpy as np
 from facelib.tracking.closedloop import (
     bilabial_closures,
     closure_recall,
+    curve_correlation,
+    curve_gain,
     false_closures,
     lip_closures,
 )
+from facelib.visemes.timeline import VisemeSpan, bilabial_spans
 
 FPS = 25.0
 
@@ -47,3 +50,18 @@ def test_lips_must_touch_and_part_again() -> None:
     extra = apart.copy()
     extra[52:55] = 0.0                   # the avatar closes where the source does not
     assert false_closures(truth, extra) == 1
+
+
+def test_bilabial_spans_come_from_viseme_1_only() -> None:
+    track = [VisemeSpan(0, "sil", 0, 300), VisemeSpan(1, "PP", 300, 380, ("M",)),
+             VisemeSpan(10, "aa", 380, 500, ("AY",)), VisemeSpan(1, "PP", 500, 560, ("B",))]
+    assert bilabial_spans(track) == [(300, 380), (500, 560)]
+    assert bilabial_spans(None) == []  # an animation without speech
+
+
+def test_curve_agreement() -> None:
+    t = np.sin(np.linspace(0, 6, 50))
+    assert abs(curve_correlation(t, 0.5 * t + 3) - 1) < 1e-12
+    assert abs(curve_gain(t, 0.5 * t + 3) - 0.5) < 1e-12
+    assert np.isnan(curve_correlation(t, np.zeros(50)))
+    assert np.isnan(curve_gain(np.zeros(50), t))

@@ -88,6 +88,8 @@ def test_learn_open_gain_is_the_slope_through_zero_of_open_frames():
     assert learn_open_gain(aperture, true_separation, is_open) == pytest.approx(2000.0)
     with pytest.raises(ParameterError, match="no open frame"):
         learn_open_gain(aperture, true_separation, np.zeros(5, bool))
+    with pytest.raises(ParameterError, match="finite"):
+        learn_open_gain(np.array([0.1, np.nan, 0.3, 0.0, 0.05]), true_separation, is_open)
     with pytest.raises(ParameterError, match=r"true_separation \(4,\)"):
         learn_open_gain(aperture, true_separation[:4], is_open)
 
