@@ -5,10 +5,11 @@ A low-pass filter whose cutoff rises with the signal's speed: ``fc = min_cutoff 
 raises the cutoff and keeps its depth and timing.
 
 Run causally the filter lags behind fast motion by a frame or two (at 25 fps, speech's
-jaw loses about 0.03 of its correlation with the truth on the closed loop). A recorded track
-has its future too, so :func:`measure_faps <facelib.tracking.faps.measure_faps>` filters it
-both ways (``causal=False``): the mean of the forward pass and of the pass over the reversed
-track, whose lags are equal and opposite.
+jaw lost 0.03-0.05 of its correlation with the truth on the closed loop, with the model of
+the time). A recorded track has its future too, so :func:`measure_faps
+<facelib.tracking.faps.measure_faps>` filters it both ways (``causal=False``): the mean of
+the forward pass and of the pass over the reversed track, whose lags are equal and
+opposite.
 """
 
 from __future__ import annotations
