@@ -67,7 +67,8 @@ def report(title: str, truth: FapStream, bilabial: Sequence[tuple[float, float]]
     print(f"  {'FAP':>3}  {'name':<22} " + " ".join(f"{m + ' corr':>13} {'gain':>5}"
                                                      for m in METHODS))
     for fap_id in FAPS:
-        true, col = truth.values[:, fap_id - 1], fap_id - 1
+        col = fap_id - 1
+        true = truth.values[:, col]
         cells = " ".join(f"{curve_correlation(true, found[m].stream.values[:, col]):13.3f} "
                          f"{curve_gain(true, found[m].stream.values[:, col]):5.2f}"
                          for m in METHODS)
@@ -76,9 +77,9 @@ def report(title: str, truth: FapStream, bilabial: Sequence[tuple[float, float]]
     truth_gap = lip_gap(face, truth)
     closures = (bilabial_closures(truth_gap, bilabial, truth.fps),
                 lip_closures(truth_gap, truth.fps))
+    events = [closure_events(truth.values[:, f - 1], 600) for f in (19, 20)]
     for method in METHODS:
         stream = found[method].stream
-        events = [closure_events(truth.values[:, f - 1], 600) for f in (19, 20)]
         blinks = [event_recall(e, stream.values[:, f - 1])
                   for e, f in zip(events, (19, 20), strict=True)]
         print(f"  {method}: blinks recalled (FAP 19, 20) {blinks[0]:.0%}, {blinks[1]:.0%} of "

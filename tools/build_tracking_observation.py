@@ -261,20 +261,20 @@ def write_lip_rule(tracks: list[np.ndarray], streams: list[FapStream]) -> None:
         gaps.append(lip_gap(default_face(), stream)[NEUTRAL:])
     aperture, gap = np.concatenate(apertures), np.concatenate(gaps)
     true_separation = separation(np.concatenate([s.values[NEUTRAL:] for s in streams]), rule)
-    threshold = round(learn_threshold(aperture, gap >= LIPS_TOUCH), 4)
-    gain = round(learn_open_gain(aperture, true_separation, aperture >= threshold))
+    is_open = gap >= LIPS_TOUCH
+    threshold = round(learn_threshold(aperture, is_open), 4)
+    not_closed = aperture >= threshold
+    gain = round(learn_open_gain(aperture, true_separation, not_closed))
     raw = json.loads(CLOSURE.read_text())
-    n_open = int((gap >= LIPS_TOUCH).sum())
-    source = (f"learned by tools/build_tracking_observation.py: 15 % of the {n_open} "
+    source = (f"learned by tools/build_tracking_observation.py: 15 % of the {is_open.sum()} "
               f"training frames whose inner lips are apart (gap >= 0.1 MNS0 on the default "
               f"head) have a smaller aperture; no hysteresis (open_above = close_below)")
     for key in ("close_below", "open_above"):
         raw[key] = {"value": threshold, "source": source}
-    n_above = int((aperture >= threshold).sum())
     raw["open_gain"] = {"value": gain, "source": (
         f"learned by tools/build_tracking_observation.py: least-squares slope through 0 of "
         f"the true inner-lip separation (FAP units) on the aperture (MNS0) over the "
-        f"{n_above} training frames not in the closed state")}
+        f"{not_closed.sum()} training frames not in the closed state")}
     CLOSURE.write_text(json.dumps(raw, indent=2) + "\n")
     print(f"wrote {CLOSURE.relative_to(ROOT)}: closed below an aperture of {threshold} MNS0, "
           f"open at least {gain} FAP units per unit of aperture")
