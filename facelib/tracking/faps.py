@@ -41,11 +41,13 @@ from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
 from facelib.tracking import lipclosure
 from facelib.tracking.headframe import (
     HeadFrame,
+    Neutral,
     face_frame,
     fill_gaps,
     frame_spans,
-    head_frame,
+    neutral_face,
     neutral_span,
+    to_head_frame,
 )
 from facelib.tracking.layouts import LandmarkLayout, landmark_layout
 from facelib.tracking.observation import (
@@ -54,7 +56,7 @@ from facelib.tracking.observation import (
     pose_correction,
     solve_observation,
 )
-from facelib.tracking.pose import HEAD_FAP_IDS, HeadPose, euler_angles
+from facelib.tracking.pose import HEAD_FAP_IDS, HeadPose, euler_angles, join_poses
 from facelib.tracking.relations import apply_relations
 from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
@@ -116,29 +118,36 @@ def _plan(layout: LandmarkLayout, pose: HeadPose | None
     return plan
 
 
-def _gaze(local: np.ndarray, layout: LandmarkLayout, span: slice,
-          values: np.ndarray, mask: np.ndarray) -> None:
+def _pupil_offset(points: np.ndarray, rows: tuple[int, int, int]) -> np.ndarray:
+    """``(..., P, D)`` feature points -> ``(..., D)`` the pupil (row ``rows[0]``) relative to
+    the midpoint of the eye corners (rows ``rows[1:]``)."""
+    pupil, c1, c2 = rows
+    return points[..., pupil, :] - (points[..., c1, :] + points[..., c2, :]) / 2
+
+
+def _gaze(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
+          mask: np.ndarray) -> None:
     """Eyeball yaw/pitch (FAPs 23-26, AU) from pupil motion relative to the eye corners."""
     ratio = float(_model()["eyeball_radius_per_eye_width"]["value"])
     for pupil, c1, c2, yaw_id, pitch_id in _EYES:
         if not all(fp in layout.feature_points for fp in (pupil, c1, c2)):
             continue
-        a, b = local[:, layout.index(c1)], local[:, layout.index(c2)]
-        rel = local[:, layout.index(pupil)] - (a + b) / 2
-        radius = ratio * float(np.linalg.norm((a - b)[span].mean(axis=0)[:2]))
-        move = (rel - rel[span].mean(axis=0)) / radius
+        rows = (layout.index(pupil), layout.index(c1), layout.index(c2))
+        rest = frame.rest_points
+        radius = ratio * float(np.linalg.norm((rest[rows[1]] - rest[rows[2]])[:2]))
+        move = (_pupil_offset(frame.points, rows) - _pupil_offset(rest, rows)) / radius
         values[:, yaw_id - 1] = np.arcsin(np.clip(move[:, 0], -1, 1)) / ANGLE_UNIT
         values[:, pitch_id - 1] = np.arcsin(np.clip(-move[:, 1], -1, 1)) / ANGLE_UNIT
         mask[:, [yaw_id - 1, pitch_id - 1]] = True
 
 
-def _fit(local: np.ndarray, span: slice, units: Mapping[str, float], model: RigModel,
-         *, values: np.ndarray, mask: np.ndarray) -> None:
+def _fit(frame: HeadFrame, model: RigModel, *, values: np.ndarray, mask: np.ndarray
+         ) -> None:
     """FAPs of ``model`` by fitting the face's rig, plus a small residual head motion, to
     the landmark motion relative to nearby anchors (:mod:`~facelib.tracking.rigfit`)."""
-    points = local[:, model.landmarks]
-    rest = points[span].mean(axis=0)
-    found = fit_faps(model, points[..., :2] - rest[:, :2], units,
+    points = frame.landmarks[:, model.landmarks]
+    rest = frame.rest[model.landmarks]
+    found = fit_faps(model, points[..., :2] - rest[:, :2], frame.fapu,
                      rest=rest if points.shape[2] == 3 else None)
     values[:, model.faps - 1] = found
     mask[:, model.faps - 1] = True
@@ -218,7 +227,7 @@ def _observe(frame: HeadFrame, model: ObservationModel, *, values: np.ndarray,
     mask[:, model.faps - 1] = True
 
 
-def _face_faps(frame: HeadFrame, layout: LandmarkLayout, span: slice, model: Model | None
+def _face_faps(frame: HeadFrame, layout: LandmarkLayout, model: Model | None
                ) -> tuple[np.ndarray, np.ndarray]:
     """``(n, 84)`` values and mask of the face FAPs: the learned model, or eq. 4.16 (refined
     by a rig fit) and the gaze of the pupils."""
@@ -233,20 +242,61 @@ def _face_faps(frame: HeadFrame, layout: LandmarkLayout, span: slice, model: Mod
         values[:, col] = sign * moved[:, row, axis] / frame.fapu[unit]
         mask[:, col] = True
     if model is not None:
-        _fit(frame.landmarks, span, frame.fapu, model, values=values, mask=mask)
-    _gaze(frame.points, layout, span, values, mask)
+        _fit(frame, model, values=values, mask=mask)
+    _gaze(frame, layout, values, mask)
     return values, mask
 
 
-def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
-                 mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The mouth state from MediaPipe's inner-lip aperture (:mod:`~facelib.tracking.lipclosure`)
-    applied to ``values``: closed lips for p, b, m, at least the aperture's opening
-    elsewhere; other layouts pass unchanged."""
-    if layout.name != "mediapipe":
-        return values, mask
+@dataclass(frozen=True)
+class _Chunk:
+    """What :func:`_measure_chunk` reads off ``n`` frames: ``values`` and ``mask``
+    ``(n, 84)``, the head ``pose`` (None without stable points) and the inner-lip
+    ``aperture`` ``(n,)`` (None when the mouth state is not read)."""
+
+    values: np.ndarray
+    mask: np.ndarray
+    pose: HeadPose | None
+    aperture: np.ndarray | None
+
+
+_CHUNK_FRAMES = 1024
+"""Frames put in the head frame at a time, so a long track needs a few copies of a chunk's
+landmarks, not of the whole track's."""
+
+
+def _measure_chunk(landmarks: np.ndarray, neutral: Neutral, layout: LandmarkLayout,
+                   model: Model | None, *, lips: bool) -> _Chunk:
+    """The face FAPs, head pose and (``lips``) inner-lip aperture of ``(n, K, D)`` gap-free
+    landmarks, measured against ``neutral``."""
+    frame = to_head_frame(landmarks, neutral, layout=layout)
+    values, mask = _face_faps(frame, layout, model)
+    if frame.pose is not None:
+        angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
+        if isinstance(model, ObservationModel):  # the fit's learned error taken out
+            angles += pose_correction(model, frame.motion, frame.fapu)
+        values[:, [f - 1 for f in HEAD_FAP_IDS]] = angles / ANGLE_UNIT
+        mask[:, [f - 1 for f in HEAD_FAP_IDS]] = True
+    aperture = (lipclosure.inner_lip_aperture(frame, lipclosure.lip_closure())
+                if lips else None)
+    return _Chunk(values, mask, frame.pose, aperture)
+
+
+def _join(chunks: list[_Chunk]) -> _Chunk:
+    """Consecutive chunks of a track as one."""
+    poses = [c.pose for c in chunks if c.pose is not None]
+    apertures = [c.aperture for c in chunks if c.aperture is not None]
+    return _Chunk(np.concatenate([c.values for c in chunks]),
+                  np.concatenate([c.mask for c in chunks]),
+                  join_poses(poses) if poses else None,
+                  np.concatenate(apertures) if apertures else None)
+
+
+def _closed_lips(aperture: np.ndarray, values: np.ndarray, mask: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The mouth state read off MediaPipe's ``(n,)`` inner-lip ``aperture``
+    (:mod:`~facelib.tracking.lipclosure`) applied to ``values``: closed lips for p, b, m,
+    at least the aperture's opening elsewhere."""
     rule = lipclosure.lip_closure()
-    aperture = lipclosure.inner_lip_aperture(frame, rule)
     closed = lipclosure.closed_frames(aperture, close_below=rule.close_below,
                                       open_above=rule.open_above)
     mask = mask.copy()
@@ -257,17 +307,18 @@ def _closed_lips(frame: HeadFrame, layout: LandmarkLayout, values: np.ndarray,
 
 def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
             states: Mapping[str, np.ndarray] | None, relations: bool,
-            lips: tuple[HeadFrame, LandmarkLayout] | None) -> tuple[np.ndarray, np.ndarray]:
+            aperture: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """Smoothing, the floor of unidirectional FAPs, the mouth state (closed for p/b/m, at
-    least the aperture's opening elsewhere; ``lips``: where to read it), then eq. 4.17.
+    least the inner-lip ``aperture``'s ``(n,)`` opening elsewhere; none without one),
+    then eq. 4.17.
     ``values`` and ``mask`` are ``(n, 84)``."""
     if smooth:
         values = _smooth(values, mask, rate)
     for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
         if fap.bidirectional is False and fap.min == 0:
             values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
-    if lips is not None:  # after the floor: the lip separation counts open_jaw as shown
-        values, mask = _closed_lips(*lips, values, mask)
+    if aperture is not None:  # after the floor: the lip separation counts open_jaw as shown
+        values, mask = _closed_lips(aperture, values, mask)
     if relations or states:
         values, mask = apply_relations(values, mask, frame_states=states)
     return values, mask
@@ -319,20 +370,13 @@ def measure_faps(
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
-    span = neutral_span(neutral, len(data))
-    frame = head_frame(data, layout=layout, span=span, fapu=fapu)
-    values, mask = _face_faps(frame, layout, span, model)
-    pose = frame.pose
-    if pose is not None:
-        angles = np.stack(euler_angles(pose.rotation), axis=1)
-        if isinstance(model, ObservationModel):  # the fit's learned error taken out
-            angles += pose_correction(model, frame.motion, frame.fapu)
-        values[:, [f - 1 for f in HEAD_FAP_IDS]] = angles / ANGLE_UNIT
-        mask[:, [f - 1 for f in HEAD_FAP_IDS]] = True
-    lips = (frame, layout) if close_lips and model is not None else None
-    values, mask = _finish(values, mask, rate, smooth=smooth, states=states,
-                           relations=relations, lips=lips)
-    return TrackedFaps(FapStream(rate, values, mask), frame.fapu, pose, filled)
+    rest = neutral_face(data, layout=layout, span=neutral_span(neutral, len(data)), fapu=fapu)
+    lips = close_lips and model is not None and layout.name == "mediapipe"
+    found = _join([_measure_chunk(data[i:i + _CHUNK_FRAMES], rest, layout, model, lips=lips)
+                   for i in range(0, len(data), _CHUNK_FRAMES)])
+    values, mask = _finish(found.values, found.mask, rate, smooth=smooth, states=states,
+                           relations=relations, aperture=found.aperture)
+    return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
 
 
 def landmarks_to_faps(landmarks: np.ndarray, *, fps: float, **options: object) -> FapStream:

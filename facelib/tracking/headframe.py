@@ -18,8 +18,8 @@ from facelib.tracking.layouts import LandmarkLayout
 from facelib.tracking.pose import HeadPose, fit_pose, refine_pose_2d, unpose, unpose_2d
 from facelib.tracking.userfapu import user_fapu
 
-__all__ = ["HeadFrame", "face_frame", "fill_gaps", "frame_spans", "head_frame",
-           "neutral_span"]
+__all__ = ["HeadFrame", "Neutral", "face_frame", "fill_gaps", "frame_spans", "head_frame",
+           "neutral_face", "neutral_span", "to_head_frame"]
 
 
 @dataclass(frozen=True)
@@ -74,13 +74,15 @@ def frame_spans(frames: np.ndarray) -> str:
 def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
     """Interpolate frames whose landmarks hold NaN (no face) linearly in time.
 
-    ``(n, K, D)`` -> (filled copy, the filled frame indices). Frames before the first or
-    after the last face hold the nearest face. TrackingError if no frame has a face.
+    ``(n, K, D)`` -> (the landmarks as float64, a filled copy if any frame was lost; the
+    filled frame indices). Frames before the first or after the last face hold the nearest
+    face. TrackingError if no frame has a face.
     """
-    data = np.array(landmarks, np.float64)
+    data = np.asarray(landmarks, np.float64)
     lost = ~np.isfinite(data).reshape(len(data), -1).all(axis=1)
     if not lost.any():
         return data, ()
+    data = data.copy()
     good = np.flatnonzero(~lost)
     if not good.size:
         raise TrackingError(f"no face in any of the {len(data)} frames")
@@ -100,32 +102,71 @@ def neutral_span(neutral: int | tuple[int, int], n: int) -> slice:
     return slice(start, stop)
 
 
-def _remove_pose(points: np.ndarray, layout: LandmarkLayout, span: slice,
-                 rest_all: np.ndarray) -> tuple[np.ndarray, HeadPose | None]:
-    """All landmarks ``(n, K, D)`` in the neutral head's frame, and the fit."""
+@dataclass(frozen=True)
+class Neutral:
+    """The neutral face a track is measured against (from its neutral frames alone, so a
+    long track can be put in the head frame a chunk at a time).
+
+    Attributes
+    ----------
+    image_rest: ``(K, D) float64`` the landmarks' mean over the neutral frames in the face
+        frame, pose not removed: what the pose fit fits to.
+    rest: ``(K, D) float64`` their mean in the neutral head's frame.
+    rest_points: ``(P, D) float64`` the layout's feature points there.
+    fapu: the user's FAPU in the landmarks' unit per FAP unit (``AU`` in radians).
+    """
+
+    image_rest: np.ndarray
+    rest: np.ndarray
+    rest_points: np.ndarray
+    fapu: dict[str, float]
+
+
+def _remove_pose(points: np.ndarray, layout: LandmarkLayout, image_rest: np.ndarray
+                 ) -> tuple[np.ndarray, HeadPose | None]:
+    """All landmarks ``(n, K, D)`` (face frame) in the neutral head's frame, and the fit to
+    the neutral ``image_rest`` ``(K, D)``."""
     dim = points.shape[2]
     if len(layout.stable) > dim:
         stable = points[:, layout.stable]
-        rest = rest_all[layout.stable]
+        rest = image_rest[layout.stable]
         pose = fit_pose(rest, stable)
         if dim == 2:
             return unpose(points, pose), pose
         pose = refine_pose_2d(rest, stable, pose)
-        return unpose_2d(points, rest_all, pose), pose
+        return unpose_2d(points, image_rest, pose), pose
     if "9.3" not in layout.feature_points:
         raise TrackingError("without stable points the nose tip 9.3 must be tracked "
                             "(the seed's reference point)")
     nose = layout.feature_point_positions(points)[:, layout.index("9.3")]
-    return points - (nose - nose[span].mean(axis=0))[:, None, :], None
+    nose_rest = layout.feature_point_positions(image_rest[None])[0, layout.index("9.3")]
+    return points - (nose - nose_rest)[:, None, :], None
+
+
+def neutral_face(landmarks: np.ndarray, *, layout: LandmarkLayout, span: slice,
+                 fapu: Mapping[str, float] | None = None) -> Neutral:
+    """The :class:`Neutral` of ``(n, K, D)`` image-coordinate landmarks without gaps
+    (:func:`fill_gaps`), from the neutral frames ``span``, with FAPU overrides ``fapu``."""
+    points = face_frame(landmarks[span])
+    image_rest = points.mean(axis=0)
+    rest = _remove_pose(points, layout, image_rest)[0].mean(axis=0)
+    rest_points = layout.feature_point_positions(rest[None])[0]
+    units = user_fapu(dict(zip(layout.feature_points, rest_points, strict=True)), fapu)
+    return Neutral(image_rest, rest, rest_points, units)
+
+
+def to_head_frame(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkLayout
+                  ) -> HeadFrame:
+    """``(n, K, D)`` image-coordinate landmarks without gaps in the head frame of
+    ``neutral`` (any frames of the track it was taken from, e.g. a chunk of a long one)."""
+    local, pose = _remove_pose(face_frame(landmarks), layout, neutral.image_rest)
+    return HeadFrame(local, neutral.rest, layout.feature_point_positions(local),
+                     neutral.rest_points, neutral.fapu, pose)
 
 
 def head_frame(landmarks: np.ndarray, *, layout: LandmarkLayout, span: slice,
                fapu: Mapping[str, float] | None = None) -> HeadFrame:
     """``(n, K, D)`` image-coordinate landmarks without gaps (:func:`fill_gaps`) in the
     neutral head's frame, with the neutral frames ``span`` and FAPU overrides ``fapu``."""
-    points = face_frame(landmarks)
-    local_all, pose = _remove_pose(points, layout, span, points[span].mean(axis=0))
-    local = layout.feature_point_positions(local_all)
-    rest = local[span].mean(axis=0)
-    units = user_fapu(dict(zip(layout.feature_points, rest, strict=True)), fapu)
-    return HeadFrame(local_all, local_all[span].mean(axis=0), local, rest, units, pose)
+    neutral = neutral_face(landmarks, layout=layout, span=span, fapu=fapu)
+    return to_head_frame(landmarks, neutral, layout=layout)

@@ -14,8 +14,8 @@ import numpy as np
 
 from facelib.errors import TrackingError
 
-__all__ = ["HEAD_FAP_IDS", "HeadPose", "euler_angles", "fit_pose", "refine_pose_2d", "unpose",
-           "unpose_2d"]
+__all__ = ["HEAD_FAP_IDS", "HeadPose", "euler_angles", "fit_pose", "join_poses",
+           "refine_pose_2d", "unpose", "unpose_2d"]
 
 HEAD_FAP_IDS = (48, 49, 50)
 """FAP ids (1-based; column = id - 1) of head pitch, yaw and roll, the order of
@@ -115,6 +115,13 @@ def refine_pose_2d(neutral: np.ndarray, frames: np.ndarray, pose: HeadPose, *,
         scale = scale + step[:, 3]
         trans[:, :2] += step[:, 4:]
     return HeadPose(scale, rot, trans)
+
+
+def join_poses(poses: list[HeadPose]) -> HeadPose:
+    """The fits of consecutive stretches of a track (at least one) as one."""
+    return HeadPose(np.concatenate([p.scale for p in poses]),
+                    np.concatenate([p.rotation for p in poses]),
+                    np.concatenate([p.translation for p in poses]))
 
 
 def unpose(points: np.ndarray, pose: HeadPose) -> np.ndarray:

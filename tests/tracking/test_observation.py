@@ -195,3 +195,21 @@ def test_a_bad_stream_is_not_blamed_on_the_packaged_model():
         load_observation(io.BytesIO(b"not an npz"))
     assert "observation_mediapipe" not in str(caught.value)
     assert str(caught.value).startswith("<stream>: not an observation model")
+
+
+@pytest.mark.parametrize("rig", ["observed", "default", None])
+def test_long_tracks_are_measured_in_chunks_with_the_same_result(rig, monkeypatch):
+    """Chunks of frames share the neutral face: how a track is cut changes no value."""
+    from facelib.tracking import faps
+
+    values = random_stream(40, seed=5)
+    landmarks = camera(values)
+    landmarks[17:20] = np.nan  # a lost stretch across a chunk boundary
+    whole = measure_faps(landmarks, fps=25.0, neutral=(0, 4), rig=rig)
+    monkeypatch.setattr(faps, "_CHUNK_FRAMES", 7)
+    cut = measure_faps(landmarks, fps=25.0, neutral=(0, 4), rig=rig)
+    np.testing.assert_allclose(cut.stream.values, whole.stream.values, atol=1e-9)
+    np.testing.assert_array_equal(cut.stream.mask, whole.stream.mask)
+    np.testing.assert_allclose(cut.pose.rotation, whole.pose.rotation, atol=1e-12)
+    assert cut.filled_frames == whole.filled_frames == (17, 18, 19)
+    assert whole.stream.values[:, 2].std() > 10  # the track moves: open_jaw varies
