@@ -10,11 +10,13 @@ recovers the FAPs and prints: MediaPipe frames/s, landmarks-to-FAPs frames/s, an
 the correlation and gain of the recovered against the true curve, blink and lip-closure
 recall, for the learned observation model (the default, ``rig="observed"``) and, from the
 same landmarks, the default head's rig fit (``rig="default"``, the earlier method); then the
-same without the added head turns; then both on the SOMA-X head of ``examples/heads`` (set
-up with ``facelib.setup_face``), which neither model has seen; the stylised cartoon head
-with head turns; last ``examples/tracking/expressive.fdl`` (speech with surprise, worry,
-sadness, fear and anger, which move the brows visibly, and gaze) with head turns on the
-default head, as scripted on it, and with head turns on the SOMA-X and cartoon heads.
+same without the added head turns; after the first clip, landmarks to FAPs on its
+landmarks repeated to 4- and 20-minute tracks (frames/s and peak memory); then both on
+the SOMA-X head of ``examples/heads`` (set up with ``facelib.setup_face``), which neither
+model has seen; the stylised cartoon head with head turns; last
+``examples/tracking/expressive.fdl`` (speech with surprise, worry, sadness, fear and anger,
+which move the brows visibly, and gaze) with head turns on the default head, as scripted on
+it, and with head turns on the SOMA-X and cartoon heads.
 Lip closures: the p/b/m closures of the truth (its inner-lip gap under 0.1 MNS0 during a
 bilabial viseme of the storyboard) during which the avatar's lips also touch, those after
 and before which they also part again (a closure held across several does not count); the
@@ -26,6 +28,7 @@ touch where the source's do not).
 from __future__ import annotations
 
 import time
+import tracemalloc
 from collections.abc import Sequence
 
 import numpy as np
@@ -34,6 +37,7 @@ import facelib
 from facelib.engine import Face, default_face
 from facelib.mpeg4 import FapStream
 from facelib.tracking.closedloop import (
+    ClosedLoop,
     bilabial_closures,
     closed_loop,
     closure_events,
@@ -57,7 +61,7 @@ METHODS = ("observed", "default")
 
 
 def report(title: str, truth: FapStream, bilabial: Sequence[tuple[float, float]],
-           face: Face | None = None) -> None:
+           face: Face | None = None) -> ClosedLoop:
     """One clip: ``bilabial`` are the (start, end) ms of its p/b/m visemes."""
     started = time.perf_counter()
     loop = closed_loop(truth, face=face, keep_frames=True)
@@ -89,6 +93,7 @@ def report(title: str, truth: FapStream, bilabial: Sequence[tuple[float, float]]
           + lips(closures, truth_gap, lip_gap(face, plain)))
     assert loop.frames is not None
     speed(loop.frames, loop.landmarks, truth.fps)
+    return loop
 
 
 def lips(closures: tuple[list[tuple[int, int]], ...], truth_gap: np.ndarray,
@@ -119,6 +124,23 @@ def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
           f"{n / (track_s + faps_s):.0f} frames/s")
 
 
+def long_tracks(landmarks: np.ndarray, fps: float, minutes: Sequence[float] = (4, 20)) -> None:
+    """Landmarks to FAPs on ``landmarks`` repeated to tracks of ``minutes``: time and the
+    peak memory it allocates beyond its input (both should grow linearly at most)."""
+    for length in minutes:
+        n = round(length * 60 * fps)
+        track = np.resize(landmarks, (n, *landmarks.shape[1:]))
+        tracemalloc.start()
+        started = time.perf_counter()
+        measure_faps(track, fps=fps)
+        took = time.perf_counter() - started
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        print(f"  {length:g}-minute track ({n} frames, landmarks {track.nbytes / 1e6:.0f} MB): "
+              f"landmarks to FAPs {n / took:.0f} frames/s, {peak / 1e6:.0f} MB allocated at "
+              "the peak beyond the landmarks")
+
+
 def main() -> None:
     hello, expressive = (facelib.run_fdl(f"examples/{name}.fdl")
                          for name in ("hello/hello", "tracking/expressive"))
@@ -138,8 +160,10 @@ def main() -> None:
             ("expressive.fdl as scripted", expressive, None, False),
             ("SOMA-X head, expressive.fdl with head turns", expressive, soma, True),
             ("cartoon head, expressive.fdl with head turns", expressive, cartoon, True)):
-        report(title, with_head_turns(run.faps) if turned else run.faps,
-               bilabial_spans(run.visemes), face)
+        loop = report(title, with_head_turns(run.faps) if turned else run.faps,
+                      bilabial_spans(run.visemes), face)
+        if title.startswith("hello.fdl with"):
+            long_tracks(loop.landmarks, loop.truth.fps)
 
 
 if __name__ == "__main__":
