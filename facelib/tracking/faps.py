@@ -7,7 +7,8 @@ The chain, each step a function over arrays:
    camera); frames without a face are interpolated and reported;
 2. rigid head pose per frame from the layout's stable points (similarity fit), undone so
    every point is in the neutral head's frame; with no stable points, the seed's nose-tip
-   translation correction;
+   translation correction (steps 2-5 run on chunks of frames against the neutral face read
+   first, so a long track is never copied whole);
 3. the user's FAPU from the neutral frames (eq. 4.1-4.5 with the midpoint reading of
    eq. 4.12-4.15), optionally overridden;
 4. per-axis displacements of each tracked feature point from its neutral position divided by
