@@ -574,8 +574,17 @@ def _add_track(commands: Any) -> None:
     track = commands.add_parser(
         "track", help="performance-driven animation: a face video (or landmarks) to FAPs",
         parents=[_COMMON])
-    track.add_argument("source", help="a video, or landmarks: .csv (facelib/generic, "
-                       "OpenFace), .json, .pts or a folder of .pts")
+    track.add_argument("source", nargs="?", help="a video, or landmarks: .csv "
+                       "(facelib/generic, OpenFace), .json, .pts or a folder of .pts")
+    track.add_argument("--camera", nargs="?", const="0", metavar="CAMERA",
+                       help="track live instead: a camera index (default 0), device or "
+                       "stream address, or a video read as if live; the mirror shows in a "
+                       "window until q or Esc, the .fap is measured on the whole recording")
+    track.add_argument("--no-window", action="store_true",
+                       help="--camera: record without showing the mirror")
+    track.add_argument("--neutral-frames", type=int, default=25,
+                       help="--camera: the first frames with a face that make the neutral "
+                       "(default 25; hold still)")
     track.add_argument("-o", "--output", required=True,
                        help="the .fap file to write, or - for stdout")
     track.add_argument("--landmarks-out", help="also write the landmarks as CSV")
@@ -590,21 +599,26 @@ def _add_track(commands: Any) -> None:
     track.add_argument("--layout", choices=("mediapipe", "ibug68"),
                        help="landmark files: the point layout (default: by point count)")
     track.add_argument("--fps", type=float, help="landmark files: their frame rate")
-    track.add_argument("--max-frames", type=int, help="videos: track at most this many frames")
+    track.add_argument("--max-frames", type=int,
+                       help="videos and cameras: track at most this many frames")
     track.add_argument("--dialect", default="extended",
                        choices=("standard", "xface", "greta", "extended"))
     track.set_defaults(run=_track)
 
 
-def _track(args: argparse.Namespace, console: Console) -> int:
-    import numpy as np
+def _is_landmark_file(source: Path) -> bool:
+    """Whether ``facelib track`` reads ``source`` as landmarks rather than a video."""
+    return source.is_dir() or source.suffix.lower() in (".csv", ".json", ".pts")
 
-    from facelib.tracking.faps import measure_faps
 
+def _track_source(args: argparse.Namespace, console: Console
+                  ) -> tuple[Any, float, str, Path | None, tuple[int, int]]:
+    """The landmarks, their rate and layout, the video (None for files and cameras) and
+    the neutral span of ``facelib track``'s source."""
+    if args.camera is not None:
+        return _track_camera(args, console)
     source = Path(args.source)
-    states = None
-    options: dict[str, Any] = {"neutral": _span(args.neutral), "smooth": not args.no_smooth}
-    if source.is_dir() or source.suffix.lower() in (".csv", ".json", ".pts"):
+    if _is_landmark_file(source):
         from facelib.tracking.files import read_landmarks
 
         file = read_landmarks(source)
@@ -612,14 +626,54 @@ def _track(args: argparse.Namespace, console: Console) -> int:
         layout = args.layout or file.layout
         if fps is None or layout is None:
             raise FacelibError(f"{source}: give --fps and --layout (the file does not say)")
-        landmarks, video = file.landmarks, None
-    else:
-        from facelib.tracking.video import track_video
+        return file.landmarks, fps, layout, None, _span(args.neutral)
+    from facelib.tracking.video import track_video
 
-        track = track_video(source, max_frames=args.max_frames)
-        landmarks, fps, layout, video = track.landmarks, track.info.fps, "mediapipe", source
-        console.status(f"tracked {len(landmarks)} frames of {source} ({track.info.width}x"
-              f"{track.info.height}, {fps:g} fps); no face in {len(track.lost_frames)}")
+    track = track_video(source, max_frames=args.max_frames)
+    console.status(f"tracked {len(track.landmarks)} frames of {source} ({track.info.width}x"
+                   f"{track.info.height}, {track.info.fps:g} fps); no face in "
+                   f"{len(track.lost_frames)}")
+    return track.landmarks, track.info.fps, "mediapipe", source, _span(args.neutral)
+
+
+def _track_camera(args: argparse.Namespace, console: Console
+                  ) -> tuple[Any, float, str, None, tuple[int, int]]:
+    """``facelib track --camera``: record live, then the neutral span the live run used."""
+    import numpy as np
+
+    from facelib.tracking.live import run_camera
+
+    camera = int(args.camera) if args.camera.isdigit() else args.camera
+    console.status(f"tracking {camera!r} live; hold a neutral face for "
+                   f"{args.neutral_frames} frames" + ("" if args.no_window else
+                                                      ", then q or Esc in the window ends"))
+    recording = run_camera(camera, face=_face(args.face) if args.face else None,
+                           neutral_frames=args.neutral_frames, window=not args.no_window,
+                           max_frames=args.max_frames)
+    faces = np.flatnonzero(np.isfinite(recording.landmarks).all(axis=(1, 2)))
+    if len(faces) < args.neutral_frames:
+        raise FacelibError(f"{camera!r}: a face in {len(faces)} of {len(recording.landmarks)} "
+                           f"frames, fewer than the {args.neutral_frames} neutral frames")
+    console.status(f"recorded {len(recording.landmarks)} frames at {recording.fps:.3g} fps; "
+                   f"no face in {len(recording.landmarks) - len(faces)}")
+    neutral = (int(faces[0]), int(faces[args.neutral_frames - 1]) + 1)
+    return recording.landmarks, recording.fps, "mediapipe", None, neutral
+
+
+def _track(args: argparse.Namespace, console: Console) -> int:
+    import numpy as np
+
+    from facelib.tracking.faps import measure_faps
+
+    if (args.source is None) == (args.camera is None):
+        raise FacelibError("give a source (a video or landmark file) or --camera, not both")
+    _check_suffix(args.output, (".fap",), "track")
+    if args.render and (args.camera is not None or _is_landmark_file(Path(args.source))):
+        raise FacelibError("--render needs a video source (the mirror shows it; live, the "
+                           "window is the mirror)")
+    landmarks, fps, layout, video, neutral = _track_source(args, console)
+    states = None
+    options: dict[str, Any] = {"neutral": neutral, "smooth": not args.no_smooth}
     if args.pucker:
         mask = np.zeros(len(landmarks), bool)
         for text in args.pucker:
@@ -629,7 +683,6 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     result = measure_faps(landmarks, fps=fps, layout=layout, states=states, **options)
     console.status("user FAPU (pixels): " + ", ".join(f"{k}0={v * 1024:.1f}"
                                              for k, v in result.fapu.items() if k != "AU"))
-    _check_suffix(args.output, (".fap",), "track")
     stream = result.stream
     _emit_text(format_fap(stream, dialect=args.dialect, name=Path(args.output).stem),
                args.output, console, f"({stream.n_frames} frames, {stream.duration:.2f} s)")
@@ -637,9 +690,7 @@ def _track(args: argparse.Namespace, console: Console) -> int:
         from facelib.tracking.files import write_landmarks_csv
 
         console.status(f"wrote {write_landmarks_csv(args.landmarks_out, landmarks, fps=fps)}")
-    if args.render:
-        if video is None:
-            raise FacelibError("--render needs a video source (the mirror shows it)")
+    if args.render and video is not None:
         from facelib.tracking.mirror import render_mirror
 
         out = render_mirror(video, result.stream, args.render, face=_face(args.face),

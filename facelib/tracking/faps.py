@@ -63,8 +63,9 @@ from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
 from facelib.tracking.userfapu import user_fapu
 
-__all__ = ["TrackedFaps", "face_frame", "fill_gaps", "frame_spans", "landmarks_to_faps",
-           "measure_faps"]
+__all__ = ["FilterBand", "MeasuredFrames", "TrackedFaps", "checked_inputs", "face_frame",
+           "fill_gaps", "filter_bands", "frame_spans", "landmarks_to_faps", "measure_faps",
+           "measure_frames", "mouth_closed", "settle_faps"]
 
 _AXES = {"x": 0, "y": 1, "z": 2}
 _EYES = (("3.5", "3.7", "3.11", 23, 25), ("3.6", "3.12", "3.8", 24, 26))
@@ -168,10 +169,21 @@ def default_rig() -> RigModel:
                      landmark_fapu=measured)
 
 
-def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
-    """``(n, 84)`` ``values`` with the One Euro filter run both ways (no lag: the track is
-    recorded) over the columns ``mask`` ``(n, 84)`` measures, in FAPU0 distances and
-    radians; the jaw and lips with a higher still cutoff than the rest (``model.json``)."""
+@dataclass(frozen=True)
+class FilterBand:
+    """FAP columns the One Euro filter treats alike: ``cols`` ``(c,)``, ``scale`` ``(c,)``
+    from FAP units to FAPU0 distances and radians, and the filter's parameters."""
+
+    cols: np.ndarray
+    scale: np.ndarray
+    min_cutoff: float
+    beta: float
+    d_cutoff: float
+
+
+def filter_bands(measured: np.ndarray) -> list[FilterBand]:
+    """The bands of the ``(84,) bool`` measured columns: the jaw and lips with a higher
+    still cutoff than the rest (``model.json``); a band with no column is left out."""
     params = _model()["one_euro"]
     try:
         mouth = np.isin(np.arange(N_FAPS) + 1, params["mouth_faps"])
@@ -180,15 +192,24 @@ def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
     except (KeyError, TypeError, ValueError) as exc:
         raise DataError(f"malformed one_euro parameters ({exc})",
                         path="tracking/model.json") from exc
-    out = values.copy()
+    bands = []
     for group, cutoff in zip((mouth, ~mouth), cutoffs, strict=True):
-        cols = np.flatnonzero(mask.any(axis=0) & group)
-        if not cols.size:
-            continue
+        cols = np.flatnonzero(measured & group)
         scale = np.array([ANGLE_UNIT if fap_table()[c].fapu == "AU" else 1 / FAPU_SCALE
                           for c in cols])
-        out[:, cols] = one_euro(values[:, cols] * scale, fps=fps, min_cutoff=cutoff,
-                                beta=beta, d_cutoff=d_cutoff, causal=False) / scale
+        if cols.size:
+            bands.append(FilterBand(cols, scale, cutoff, beta, d_cutoff))
+    return bands
+
+
+def _smooth(values: np.ndarray, mask: np.ndarray, fps: float) -> np.ndarray:
+    """``(n, 84)`` ``values`` with the One Euro filter run both ways (no lag: the track is
+    recorded) over the columns ``mask`` ``(n, 84)`` measures (:func:`filter_bands`)."""
+    out = values.copy()
+    for band in filter_bands(np.any(mask, axis=0)):
+        out[:, band.cols] = one_euro(values[:, band.cols] * band.scale, fps=fps,
+                                     min_cutoff=band.min_cutoff, beta=band.beta,
+                                     d_cutoff=band.d_cutoff, causal=False) / band.scale
     return out
 
 
@@ -196,10 +217,11 @@ Model = RigModel | ObservationModel
 """What :func:`measure_faps` fits to the landmark motion."""
 
 
-def _inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
-            rig: Model | Literal["auto", "default", "observed"] | None
-            ) -> tuple[np.ndarray, LandmarkLayout, Model | None]:
-    """Checked ``(n, K, D)`` landmarks, the layout, and the model to fit (or None)."""
+def checked_inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
+                   rig: Model | Literal["auto", "default", "observed"] | None
+                   ) -> tuple[np.ndarray, LandmarkLayout, Model | None]:
+    """Checked ``(n, K, D)`` landmarks (float64), the layout, and the model to fit (or None),
+    by :func:`measure_faps`'s rules for ``layout`` and ``rig``."""
     data = np.asarray(landmarks, np.float64)
     if data.ndim != 3 or data.shape[2] not in (2, 3) or len(data) == 0:
         raise TrackingError(f"landmarks must have shape (n_frames, K, 2 or 3), got {data.shape}")
@@ -249,9 +271,9 @@ def _face_faps(frame: HeadFrame, layout: LandmarkLayout, model: Model | None
 
 
 @dataclass(frozen=True)
-class _Chunk:
-    """What :func:`_measure_chunk` reads off ``n`` frames: ``values`` and ``mask``
-    ``(n, 84)``, the head ``pose`` (None without stable points) and the inner-lip
+class MeasuredFrames:
+    """What :func:`measure_frames` reads off ``n`` frames, before smoothing: ``values`` and
+    ``mask`` ``(n, 84)``, the head ``pose`` (None without stable points) and the inner-lip
     ``aperture`` ``(n,)`` (None when the mouth state is not read)."""
 
     values: np.ndarray
@@ -265,10 +287,12 @@ _CHUNK_FRAMES = 1024
 landmarks, not of the whole track's."""
 
 
-def _measure_chunk(landmarks: np.ndarray, neutral: Neutral, layout: LandmarkLayout,
-                   model: Model | None, *, lips: bool) -> _Chunk:
+def measure_frames(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkLayout,
+                   model: Model | None, lips: bool) -> MeasuredFrames:
     """The face FAPs, head pose and (``lips``) inner-lip aperture of ``(n, K, D)`` gap-free
-    landmarks, measured against ``neutral``."""
+    landmarks (any frames of a track), measured against the track's ``neutral`` face
+    (:func:`~facelib.tracking.headframe.neutral_face`) with ``model`` (see
+    :func:`measure_faps`'s ``rig``)."""
     frame = to_head_frame(landmarks, neutral, layout=layout)
     values, mask = _face_faps(frame, layout, model)
     if frame.pose is not None:
@@ -279,47 +303,50 @@ def _measure_chunk(landmarks: np.ndarray, neutral: Neutral, layout: LandmarkLayo
         mask[:, [f - 1 for f in HEAD_FAP_IDS]] = True
     aperture = (lipclosure.inner_lip_aperture(frame, lipclosure.lip_closure())
                 if lips else None)
-    return _Chunk(values, mask, frame.pose, aperture)
+    return MeasuredFrames(values, mask, frame.pose, aperture)
 
 
-def _join(chunks: list[_Chunk]) -> _Chunk:
+def _join(chunks: list[MeasuredFrames]) -> MeasuredFrames:
     """Consecutive chunks of a track as one."""
     poses = [c.pose for c in chunks if c.pose is not None]
     apertures = [c.aperture for c in chunks if c.aperture is not None]
-    return _Chunk(np.concatenate([c.values for c in chunks]),
-                  np.concatenate([c.mask for c in chunks]),
-                  join_poses(poses) if poses else None,
-                  np.concatenate(apertures) if apertures else None)
+    return MeasuredFrames(np.concatenate([c.values for c in chunks]),
+                          np.concatenate([c.mask for c in chunks]),
+                          join_poses(poses) if poses else None,
+                          np.concatenate(apertures) if apertures else None)
 
 
-def _closed_lips(aperture: np.ndarray, values: np.ndarray, mask: np.ndarray
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """The mouth state read off MediaPipe's ``(n,)`` inner-lip ``aperture``
-    (:mod:`~facelib.tracking.lipclosure`) applied to ``values``: closed lips for p, b, m,
-    at least the aperture's opening elsewhere."""
+def mouth_closed(aperture: np.ndarray, *, closed: bool = False) -> np.ndarray:
+    """``(n,) bool`` frames in the closed mouth state by the packaged rule's hysteresis on
+    the ``(n,)`` inner-lip ``aperture`` (:mod:`~facelib.tracking.lipclosure`); ``closed``:
+    the state before the first frame."""
     rule = lipclosure.lip_closure()
-    closed = lipclosure.closed_frames(aperture, close_below=rule.close_below,
-                                      open_above=rule.open_above)
-    mask = mask.copy()
-    mask[:, lipclosure.closed_lip_columns(rule)] = True
-    values = lipclosure.close_lips(values, closed, rule)
-    return lipclosure.open_lips(values, aperture, closed, rule), mask
+    return lipclosure.closed_frames(aperture, close_below=rule.close_below,
+                                    open_above=rule.open_above, closed=closed)
 
 
-def _finish(values: np.ndarray, mask: np.ndarray, rate: float, *, smooth: bool,
-            states: Mapping[str, np.ndarray] | None, relations: bool,
-            aperture: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """Smoothing, the floor of unidirectional FAPs, the mouth state (closed for p/b/m, at
-    least the inner-lip ``aperture``'s ``(n,)`` opening elsewhere; none without one),
-    then eq. 4.17.
-    ``values`` and ``mask`` are ``(n, 84)``."""
-    if smooth:
-        values = _smooth(values, mask, rate)
+def settle_faps(values: np.ndarray, mask: np.ndarray, *,
+                lips: tuple[np.ndarray, np.ndarray] | None,
+                states: Mapping[str, np.ndarray] | None = None, relations: bool = True
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """After smoothing: the floor of unidirectional FAPs, the mouth state, then eq. 4.17.
+
+    ``values`` and ``mask`` ``(n, 84)``; ``lips``: the inner-lip aperture ``(n,)`` and the
+    closed state ``(n,) bool`` (:func:`mouth_closed`): closed lips for p/b/m, at least the
+    aperture's opening elsewhere (None: left as measured); ``states`` and ``relations`` as
+    in :func:`measure_faps`.
+    """
+    values = values.copy()
     for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
         if fap.bidirectional is False and fap.min == 0:
             values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
-    if aperture is not None:  # after the floor: the lip separation counts open_jaw as shown
-        values, mask = _closed_lips(aperture, values, mask)
+    if lips is not None:  # after the floor: the lip separation counts open_jaw as shown
+        aperture, closed = lips
+        rule = lipclosure.lip_closure()
+        mask = mask.copy()
+        mask[:, lipclosure.closed_lip_columns(rule)] = True
+        values = lipclosure.close_lips(values, closed, rule)
+        values = lipclosure.open_lips(values, aperture, closed, rule)
     if relations or states:
         values, mask = apply_relations(values, mask, frame_states=states)
     return values, mask
@@ -366,17 +393,20 @@ def measure_faps(
         aperture shows in the others. False turns both off.
     """
     rate = check_fps(fps)
-    data, layout, model = _inputs(landmarks, layout, rig)
+    data, layout, model = checked_inputs(landmarks, layout, rig)
     data, filled = fill_gaps(data)
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
     rest = neutral_face(data, layout=layout, span=neutral_span(neutral, len(data)), fapu=fapu)
     lips = close_lips and model is not None and layout.name == "mediapipe"
-    found = _join([_measure_chunk(data[i:i + _CHUNK_FRAMES], rest, layout, model, lips=lips)
-                   for i in range(0, len(data), _CHUNK_FRAMES)])
-    values, mask = _finish(found.values, found.mask, rate, smooth=smooth, states=states,
-                           relations=relations, aperture=found.aperture)
+    found = _join([measure_frames(data[i:i + _CHUNK_FRAMES], rest, layout=layout, model=model,
+                                  lips=lips) for i in range(0, len(data), _CHUNK_FRAMES)])
+    values = _smooth(found.values, found.mask, rate) if smooth else found.values
+    aperture = found.aperture
+    values, mask = settle_faps(
+        values, found.mask, states=states, relations=relations,
+        lips=None if aperture is None else (aperture, mouth_closed(aperture)))
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
 
 

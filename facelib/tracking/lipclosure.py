@@ -103,16 +103,17 @@ def inner_lip_aperture(frame: HeadFrame, rule: LipClosure) -> np.ndarray:
     return (upper - lower).mean(axis=1) / (frame.fapu["MNS"] * FAPU_SCALE)
 
 
-def closed_frames(aperture: np.ndarray, *, close_below: float,
-                  open_above: float) -> np.ndarray:
+def closed_frames(aperture: np.ndarray, *, close_below: float, open_above: float,
+                  closed: bool = False) -> np.ndarray:
     """``(n,) bool`` frames in the closed state: entered when ``aperture`` ``(n,)`` falls
-    below ``close_below``, left when it rises above ``open_above``."""
-    closed = np.zeros(len(aperture), bool)
-    state = False
+    below ``close_below``, left when it rises above ``open_above``; ``closed``: the state
+    before the first frame (a live track's last)."""
+    out = np.zeros(len(aperture), bool)
+    state = bool(closed)
     for i, value in enumerate(np.asarray(aperture, np.float64)):
         state = value < (open_above if state else close_below)
-        closed[i] = state
-    return closed
+        out[i] = state
+    return out
 
 
 def separation(values: np.ndarray, rule: LipClosure) -> np.ndarray:

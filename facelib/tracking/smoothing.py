@@ -14,11 +14,22 @@ opposite.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from facelib.checks import check_fps, check_number
 
-__all__ = ["one_euro"]
+__all__ = ["EuroState", "one_euro", "one_euro_step"]
+
+
+@dataclass(frozen=True)
+class EuroState:
+    """Where a causal One Euro filter stands after a frame: its ``(C,)`` output ``value``
+    and its ``(C,)`` filtered ``speed`` (signal units per second)."""
+
+    value: np.ndarray
+    speed: np.ndarray
 
 
 def _alpha(cutoff: np.ndarray | float, dt: float) -> np.ndarray:
@@ -49,13 +60,22 @@ def one_euro(signal: np.ndarray, *, fps: float, min_cutoff: float = 4.0, beta: f
                             d_cutoff=d_cutoff)[::-1]
         return 0.5 * (forward + backward)
     out = np.empty_like(x)
-    if len(x) == 0:
-        return out
-    a_d = _alpha(d_cutoff, dt)
-    prev = out[0] = x[0]
-    speed = np.zeros(x.shape[1:])
-    for i in range(1, len(x)):
-        speed = speed + a_d * ((x[i] - prev) / dt - speed)
-        a = _alpha(min_cutoff + beta * np.abs(speed), dt)
-        prev = out[i] = prev + a * (x[i] - prev)
+    state = None
+    for i, row in enumerate(x):
+        state = one_euro_step(row, state, dt=dt, min_cutoff=min_cutoff, beta=beta,
+                              d_cutoff=d_cutoff)
+        out[i] = state.value
     return out
+
+
+def one_euro_step(signal: np.ndarray, state: EuroState | None, *, dt: float,
+                  min_cutoff: float, beta: float, d_cutoff: float) -> EuroState:
+    """One frame of the causal filter: ``(C,)`` ``signal`` after ``state`` (None at the first
+    frame, which passes unchanged), ``dt`` seconds after it; the parameters are those of
+    :func:`one_euro` (not checked here: the live loop calls this every frame)."""
+    x = np.asarray(signal, np.float64)
+    if state is None:
+        return EuroState(x.copy(), np.zeros_like(x))
+    speed = state.speed + _alpha(d_cutoff, dt) * ((x - state.value) / dt - state.speed)
+    a = _alpha(min_cutoff + beta * np.abs(speed), dt)
+    return EuroState(state.value + a * (x - state.value), speed)

@@ -109,3 +109,42 @@ def test_lost_stretch_and_a_second_face_are_named(face_video, tmp_path, capsys):
     assert "no face in frames 5-7 of 16; interpolated" in err
     assert "several faces in frames 10-12; tracked the largest" in err
     assert read_fap(tmp_path / "e.fap").n_frames == N
+
+
+def test_camera_mode_reads_a_video_as_if_live(face_video, tmp_path, capsys):
+    """`--camera` with a video file: OpenCV reads it like a camera; the .fap is measured on
+    the whole recording with the live neutral, as `track` measures the file itself."""
+    out = tmp_path / "live.fap"
+    status = main(["track", "--camera", str(face_video), "--no-window", "--neutral-frames", "4",
+                   "-o", str(out), "--landmarks-out", str(tmp_path / "live.csv")])
+    err = capsys.readouterr().err
+    assert status == 0, err
+    assert "recorded 16 frames at 25 fps; no face in 0" in err
+    live = read_fap(out)
+    assert live.n_frames == N and live.fps == 25
+    assert main(["track", str(face_video), "-o", str(tmp_path / "file.fap"),
+                 "--neutral", "0:4"]) == 0
+    recorded = read_fap(tmp_path / "file.fap")
+    jaw = live.values[:, 2]
+    assert np.corrcoef(jaw, recorded.values[:, 2])[0, 1] > 0.99
+    assert read_landmarks(tmp_path / "live.csv").landmarks.shape == (N, 478, 3)
+
+
+def test_camera_mode_refuses_before_it_records(face_video, tmp_path, capsys, monkeypatch):
+    fap = str(tmp_path / "x.fap")
+    assert main(["track", str(face_video), "--camera", "-o", fap]) == 1
+    assert "not both" in capsys.readouterr().err
+    assert main(["track", "--camera", "-o", fap, "--render", str(tmp_path / "m.mp4")]) == 1
+    assert "--render needs a video source" in capsys.readouterr().err
+    assert main(["track", "--camera", str(tmp_path / "none.mp4"), "--no-window",
+                 "-o", fap]) == 1
+    assert "cannot open the camera or stream" in capsys.readouterr().err
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main(["track", "--camera", str(face_video), "-o", fap]) == 1
+    assert "no display" in capsys.readouterr().err
+    assert main(["track", "--camera", str(face_video), "--no-window", "--neutral-frames",
+                 "20", "-o", fap]) == 1
+    assert "a face in 16 of 16 frames, fewer than the 20 neutral frames" in (
+        capsys.readouterr().err)
+    assert not (tmp_path / "x.fap").exists()
