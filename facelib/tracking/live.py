@@ -83,14 +83,16 @@ class LiveFaps:
         again for a frame without a face."""
         if landmarks is None or not np.isfinite(landmarks).all():
             return None if self._last is None else self._last.copy()
+        frame = np.asarray(landmarks, np.float64)
+        first = self._neutral.rest if self._neutral is not None else (
+            self._collected[0] if self._collected else frame)
+        if frame.shape != first.shape:
+            raise TrackingError(f"landmarks of shape {frame.shape} after ones of {first.shape}")
         if self._neutral is None:
-            self._collect(np.asarray(landmarks, np.float64))
+            self._collect(frame)
             return None
         assert self._layout is not None
-        row = np.asarray(landmarks, np.float64)[None]
-        if row.shape[1:] != self._neutral.rest.shape:
-            raise TrackingError(f"landmarks of shape {row.shape[1:]} after a neutral of "
-                                f"{self._neutral.rest.shape}")
+        row = frame[None]
         lips = self._close_lips and self._model is not None and self._layout.name == "mediapipe"
         found = measure_frames(row, self._neutral, layout=self._layout, model=self._model,
                                lips=lips)

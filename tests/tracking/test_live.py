@@ -66,6 +66,8 @@ def test_the_neutral_waits_for_faces():
     live = LiveFaps(fps=25, neutral_frames=2)
     landmarks = camera(smooth_stream(6))
     assert live.push(None) is None and live.push(landmarks[0]) is None
+    with pytest.raises(TrackingError, match=r"shape \(68, 3\) after ones of \(478, 3\)"):
+        live.push(landmarks[1, :68])
     assert live.push(landmarks[1]) is None and live.neutral is not None
     assert live.push(landmarks[2]) is not None
     with pytest.raises(TrackingError, match="shape"):
