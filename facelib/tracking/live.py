@@ -142,7 +142,8 @@ class LiveRecording:
     ----------
     landmarks: ``(n, 478, 3) float64`` MediaPipe landmarks per frame (NaN: no face).
     values: ``(n, 84) float64`` the FAPs shown live (NaN while the neutral was collected).
-    fps: the frames' rate (the source's, or for a camera the rate frames were processed at).
+    fps: the frames' rate: the source's, or for a camera (and a source that does not say)
+        the rate frames were read at (30 for a single frame that does not say).
     """
 
     landmarks: np.ndarray
@@ -203,7 +204,7 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
     live = LiveFaps(fps=nominal if nominal > 0 else 30.0, neutral_frames=neutral_frames)
     points: list[np.ndarray] = []
     shown: list[np.ndarray] = []
-    started = time.perf_counter()
+    times: list[float] = []
     try:
         with FaceMeshTracker(video=True, max_faces=1) as tracker, \
                 _Avatar(face, enabled=window) as avatar:
@@ -211,6 +212,7 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
                 ok, bgr = capture.read()
                 if not ok:
                     break
+                times.append(time.perf_counter())
                 found = tracker.detect(np.ascontiguousarray(bgr[..., ::-1]))
                 values = live.push(None if found is None else found.points)
                 points.append(np.full((N_LANDMARKS, 3), np.nan) if found is None
@@ -224,9 +226,10 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
         capture.release()
     if not points:
         raise TrackingError(f"no frame from {source!r}")
-    elapsed = time.perf_counter() - started
     camera = isinstance(source, int) or str(source).startswith("/dev/")
-    fps = len(points) / elapsed if camera or nominal <= 0 else nominal
+    if (camera or nominal <= 0) and len(times) > 1 and times[-1] > times[0]:
+        nominal = (len(times) - 1) / (times[-1] - times[0])  # the rate frames came at
+    fps = nominal if nominal > 0 else 30.0
     return LiveRecording(np.stack(points), np.stack(shown), fps)
 
 
