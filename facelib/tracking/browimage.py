@@ -1,0 +1,222 @@
+"""The inner brows' motion read off the video frames: what MediaPipe's landmarks miss.
+
+MediaPipe's brow landmarks report about half of the brows' motion and mix a brow's raise
+with its squeeze (FAPs 37/38 pull it toward the midline and down). The image itself holds
+both: a patch over each inner brow (from above the brow to just under it, clear of the
+lids and lashes) is laid on the neutral face, sampled in every frame through the head's
+pose, and registered against the neutral frames' patch by normalised cross-correlation in
+the head's frame, across (squeeze) and up (raise). The two shifts of each brow, over the
+user's eye separation ES0, join the landmark motion as inputs of the observation model
+(:mod:`~facelib.tracking.observation`), which learns what they mean from its training
+renders.
+
+The pose used for sampling is the tracking's rigid fit with the model's learned correction
+of its angles, and its scale and translation fitted again on the nose bridge and tip alone
+(the nostrils move with speech). Sizes are in ES0 (``model.json``, ``brow_image``), so a
+patch covers the same part of any face at any resolution.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+
+from facelib.data import json_data
+from facelib.errors import DataError, TrackingError
+from facelib.mpeg4 import FAPU_SCALE
+from facelib.tracking.headframe import Neutral, to_head_frame
+from facelib.tracking.layouts import landmark_layout
+from facelib.tracking.observation import ObservationModel, pose_correction
+from facelib.tracking.pose import HeadPose, euler_angles
+
+__all__ = ["N_FEATURES", "BrowPatches", "brow_features", "brow_patches", "sampling_poses"]
+
+N_FEATURES = 4
+"""Features per frame: across and up shifts of the face's left inner brow, then the right's."""
+
+
+@dataclass(frozen=True)
+class _Settings:
+    """``model.json``'s ``brow_image``: landmark rows and sizes in ES0."""
+
+    brows: tuple[tuple[int, int], tuple[int, int]]
+    nose: tuple[int, ...]
+    half_width: float
+    above: float
+    below: float
+    across: float
+    up: float
+    down: float
+    step: float
+
+
+@cache
+def _settings() -> _Settings:
+    raw = json_data("tracking/model.json").get("brow_image")
+    try:
+        brows = tuple((int(a), int(b)) for a, b in (raw["left"], raw["right"]))
+        sizes = {k: float(raw[k]) for k in ("half_width", "above", "below", "search_across",
+                                            "search_up", "search_down", "step")}
+        return _Settings(brows, tuple(int(i) for i in raw["nose"]),  # type: ignore[arg-type]
+                         sizes["half_width"], sizes["above"], sizes["below"],
+                         sizes["search_across"], sizes["search_up"], sizes["search_down"],
+                         sizes["step"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DataError(f"malformed brow_image settings ({exc})",
+                        path="tracking/model.json") from exc
+
+
+@dataclass(frozen=True)
+class BrowPatches:
+    """The neutral brows a track's frames are registered against.
+
+    Attributes
+    ----------
+    regions: ``(2, rh, rw, 3) float64`` points on the neutral face (face frame, the
+        landmarks' unit) sampled in every frame: each brow's patch widened by the search.
+    templates: ``(2, th, tw) float32`` the neutral frames' mean grey patch of each brow.
+    step: the grid's spacing (the landmarks' unit).
+    """
+
+    regions: np.ndarray
+    templates: np.ndarray
+    step: float
+
+
+def _grey(image: np.ndarray) -> np.ndarray:
+    """``(H, W, 3) uint8`` RGB -> ``(H, W) float32`` luma."""
+    import cv2
+
+    return cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2GRAY).astype(np.float32)
+
+
+def sampling_poses(landmarks: np.ndarray, neutral: Neutral, model: ObservationModel
+                   ) -> HeadPose:
+    """``(n, 478, 3)`` gap-free MediaPipe landmarks -> the poses the brows are sampled
+    through: the fit's angles with ``model``'s correction, scale and translation fitted
+    again on the nose bridge and tip."""
+    from facelib.engine.rigid import rotation_matrices
+
+    layout = landmark_layout("mediapipe")
+    frame = to_head_frame(landmarks, neutral, layout=layout)
+    assert frame.pose is not None
+    angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
+    angles += pose_correction(model, frame.motion, frame.fapu)
+    rotation = rotation_matrices(angles[:, 0], angles[:, 1], angles[:, 2])
+    nose = list(_settings().nose)
+    turned = np.einsum("nij,sj->nsi", rotation, neutral.image_rest[nose])[..., :2]  # (n, s, 2)
+    seen = np.asarray(landmarks, np.float64)[:, nose, :2] * [1.0, -1.0]  # face frame x, y
+    n, s = turned.shape[:2]
+    design = np.zeros((n, s, 2, 3))
+    design[..., 0] = turned
+    design[..., 0, 1] = design[..., 1, 2] = 1.0
+    design = design.reshape(n, 2 * s, 3)
+    solved = np.linalg.solve(np.einsum("nki,nkj->nij", design, design),
+                             np.einsum("nki,nk->ni", design, seen.reshape(n, 2 * s))[..., None]
+                             )[..., 0]
+    translation = np.zeros((n, 3))
+    translation[:, :2] = solved[:, 1:]
+    return HeadPose(solved[:, 0], rotation, translation)
+
+
+def _grids(neutral: Neutral) -> tuple[np.ndarray, np.ndarray, float]:
+    """Each brow's patch grid ``(2, th, tw, 3)`` and search region ``(2, rh, rw, 3)`` on the
+    neutral face (rows from the top down), and the spacing, in the landmarks' unit."""
+    from scipy.interpolate import LinearNDInterpolator
+
+    cfg = _settings()
+    es = neutral.fapu["ES"] * FAPU_SCALE
+    rest = neutral.image_rest
+    depth = LinearNDInterpolator(rest[:468, :2], rest[:468, 2])
+    step = cfg.step * es
+    tops = [rest[upper, 1] + cfg.above * es for upper, _ in cfg.brows]
+    height = max(top - (rest[lower, 1] - cfg.below * es)
+                 for top, (_, lower) in zip(tops, cfg.brows, strict=True))
+    patches: list[np.ndarray] = []
+    regions: list[np.ndarray] = []
+    for top, (upper, lower) in zip(tops, cfg.brows, strict=True):
+        centre = (rest[upper, 0] + rest[lower, 0]) / 2
+        for (left, up, width, tall), out in (
+                ((cfg.half_width, 0.0, 2 * cfg.half_width, height), patches),
+                ((cfg.half_width + cfg.across, cfg.up, 2 * (cfg.half_width + cfg.across),
+                  height + (cfg.up + cfg.down) * es), regions)):
+            xs = centre - left * es + step * np.arange(round(width * es / step) + 1)
+            ys = top + up * es - step * np.arange(round(tall / step) + 1)
+            gx, gy = np.meshgrid(xs, ys)
+            out.append(np.stack([gx, gy, depth(gx, gy)], axis=-1))
+    if not np.isfinite(np.concatenate([r.ravel() for r in regions])).all():
+        raise TrackingError("the brow patches reach beyond the neutral face's landmarks")
+    return np.stack(patches), np.stack(regions), step
+
+
+def _sample(grey: np.ndarray, points: np.ndarray, pose: HeadPose, i: int) -> np.ndarray:
+    """``(..., 3)`` neutral face-frame points seen in frame ``i`` through ``pose``, sampled
+    from the ``(H, W)`` grey image (bilinear; edges repeated): ``(...)`` float32."""
+    import cv2
+
+    seen = pose.scale[i] * points @ pose.rotation[i].T + pose.translation[i]
+    cols = seen[..., 0].astype(np.float32)
+    rows = (-seen[..., 1]).astype(np.float32)
+    return cv2.remap(grey, cols, rows, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
+def brow_patches(images: Iterable[np.ndarray], landmarks: np.ndarray, neutral: Neutral,
+                 model: ObservationModel) -> BrowPatches:
+    """The :class:`BrowPatches` of the neutral frames: their ``(H, W, 3) uint8`` RGB
+    ``images`` and ``(k, 478, 3)`` gap-free MediaPipe ``landmarks``, measured against the
+    track's ``neutral`` face with ``model``'s pose correction."""
+    patch, regions, step = _grids(neutral)
+    pose = sampling_poses(landmarks, neutral, model)
+    sums = np.zeros(patch.shape[:3], np.float64)
+    count = 0
+    for i, image in enumerate(images):
+        grey = _grey(image)
+        sums += np.stack([_sample(grey, p, pose, i) for p in patch])
+        count += 1
+    if count != len(landmarks):
+        raise TrackingError(f"{count} neutral images for {len(landmarks)} landmark frames")
+    return BrowPatches(regions, (sums / count).astype(np.float32), step)
+
+
+def _peak(scores: np.ndarray, at: int) -> float:
+    """Sub-step offset of the peak ``at`` of a ``(m,)`` score line by a parabola."""
+    if 0 < at < len(scores) - 1:
+        a, b, c = scores[at - 1], scores[at], scores[at + 1]
+        curve = a - 2 * b + c
+        if curve < 0:
+            return float(0.5 * (a - c) / curve)
+    return 0.0
+
+
+def brow_features(images: Iterable[np.ndarray], landmarks: np.ndarray, patches: BrowPatches,
+                  neutral: Neutral, model: ObservationModel) -> np.ndarray:
+    """``(n, 4) float64`` each inner brow's shift across (toward the face's left) and up
+    from the neutral, in the head's frame over ES0 (left brow, then right), from ``n``
+    ``(H, W, 3) uint8`` RGB ``images`` and their ``(n, 478, 3)`` MediaPipe ``landmarks``
+    (NaN rows: no face; NaN features there)."""
+    import cv2
+
+    data = np.asarray(landmarks, np.float64)
+    found = np.asarray(np.isfinite(data).reshape(len(data), -1).all(axis=1))
+    out = np.full((len(data), N_FEATURES), np.nan)
+    pose = sampling_poses(np.where(found[:, None, None], data, neutral.image_rest * [1, -1, -1]),
+                          neutral, model)
+    cfg = _settings()
+    count = 0
+    for i, image in enumerate(images):
+        count += 1
+        if not found[i]:
+            continue
+        grey = _grey(image)
+        for side in range(2):
+            region = _sample(grey, patches.regions[side], pose, i)
+            scores = cv2.matchTemplate(region, patches.templates[side], cv2.TM_CCOEFF_NORMED)
+            row, col = (int(k) for k in np.unravel_index(int(np.argmax(scores)), scores.shape))
+            out[i, 2 * side] = (col + _peak(scores[row, :], col)) * cfg.step - cfg.across
+            out[i, 2 * side + 1] = cfg.up - (row + _peak(scores[:, col], row)) * cfg.step
+    if count != len(data):
+        raise TrackingError(f"{count} images for {len(data)} landmark frames")
+    return out
