@@ -636,6 +636,15 @@ def _track_source(args: argparse.Namespace, console: Console
     return track.landmarks, track.info.fps, "mediapipe", source, _span(args.neutral)
 
 
+def _video_brows(video: Path | None, landmarks: Any, neutral: tuple[int, int]) -> Any:
+    """The brows' image shifts of a tracked video (None for other sources)."""
+    if video is None:
+        return None
+    from facelib.tracking.video import video_brows
+
+    return video_brows(video, landmarks, neutral=neutral)
+
+
 def _track_camera(args: argparse.Namespace, console: Console
                   ) -> tuple[Any, float, str, None, tuple[int, int]]:
     """``facelib track --camera``: record live, then the neutral span the live run used."""
@@ -680,7 +689,8 @@ def _track(args: argparse.Namespace, console: Console) -> int:
             start, stop = _span(text)
             mask[start:stop] = True
         states = {"pucker": mask}
-    result = measure_faps(landmarks, fps=fps, layout=layout, states=states, **options)
+    result = measure_faps(landmarks, fps=fps, layout=layout, states=states,
+                          brows=_video_brows(video, landmarks, neutral), **options)
     console.status("user FAPU (pixels): " + ", ".join(f"{k}0={v * 1024:.1f}"
                                              for k, v in result.fapu.items() if k != "AU"))
     stream = result.stream

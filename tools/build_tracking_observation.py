@@ -217,35 +217,54 @@ def speech_stream(seed: int) -> tuple[FapStream, list[tuple[float, float]]]:
     return with_neutral_lead(FapStream(FPS, values.astype(np.float32)), NEUTRAL), bilabial
 
 
-def render_and_track(stream: FapStream) -> np.ndarray:
-    """``(n, 478, 3)`` MediaPipe landmarks of the default head rendered with ``stream``."""
+def render_and_track(stream: FapStream) -> tuple[np.ndarray, np.ndarray]:
+    """``(n, 478, 3)`` MediaPipe landmarks of the default head rendered with ``stream`` and
+    ``(n, 4)`` the brows' image shifts (:mod:`facelib.tracking.browimage`, against the
+    first ``NEUTRAL`` frames, with the packaged model's pose correction)."""
     from facelib.rendering import FaceRenderer, iter_frames
+    from facelib.tracking.browimage import N_FEATURES, brow_features, brow_patches
+    from facelib.tracking.headframe import neutral_face
     from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+    from facelib.tracking.observation import default_observation
 
-    face = default_face()
+    face, model = default_face(), default_observation()
     points = np.full((stream.n_frames, N_LANDMARKS, 3), np.nan)
+    brows = np.full((stream.n_frames, N_FEATURES), np.nan)
+    lead: list[np.ndarray] = []
     with FaceRenderer(face, width=640, height=480, framing="head") as renderer, \
             FaceMeshTracker(video=True, max_faces=1) as tracker:
         for i, image in enumerate(iter_frames(renderer, face, stream)):
             found = tracker.detect(image)
             if found is not None:
                 points[i] = found.points
+            if i < NEUTRAL:
+                lead.append(image)
+                if i == NEUTRAL - 1:
+                    rest = neutral_face(points[:NEUTRAL], layout=landmark_layout("mediapipe"),
+                                        span=slice(0, NEUTRAL))
+                    patches = brow_patches(lead, points[:NEUTRAL], rest, model)
+                    brows[:NEUTRAL] = brow_features(lead, points[:NEUTRAL], patches, rest, model)
+                continue
+            brows[i] = brow_features([image], points[i:i + 1], patches, rest, model)[0]
             if i % 200 == 0:
                 print(f"  frame {i} of {stream.n_frames}", flush=True)
-    return points
+    return points, brows
 
 
-def cached_track(stream: FapStream, cache: Path, fresh: bool) -> np.ndarray:
-    """Landmarks of ``stream`` rendered and tracked, from ``cache`` when it holds them."""
+def cached_track(stream: FapStream, cache: Path, fresh: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Landmarks and brow image shifts of ``stream`` rendered and tracked, from ``cache``
+    when it holds them."""
     if cache.exists() and not fresh:
         with np.load(cache) as cached:
-            if np.array_equal(cached["values"], stream.values):
-                return np.asarray(cached["landmarks"], np.float64)
-        raise SystemExit(f"{cache} was made with other options; pass --fresh")
-    landmarks = render_and_track(stream)
+            if np.array_equal(cached["values"], stream.values) and "brows" in cached.files:
+                return (np.asarray(cached["landmarks"], np.float64),
+                        np.asarray(cached["brows"], np.float64))
+        raise SystemExit(f"{cache} was made with other options or without brows; pass --fresh")
+    landmarks, brows = render_and_track(stream)
     cache.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(cache, landmarks=landmarks.astype(np.float32), values=stream.values)
-    return landmarks
+    np.savez_compressed(cache, landmarks=landmarks.astype(np.float32), values=stream.values,
+                        brows=brows)
+    return landmarks, brows
 
 
 def write_lip_rule(tracks: list[np.ndarray], streams: list[FapStream]) -> None:
@@ -285,8 +304,9 @@ def validate(model: ObservationModel, fresh: bool) -> None:
     correlation of each FAP of ``VALIDATION_FAPS``, the inner-lip gap and the p/b/m
     closures."""
     stream, bilabial = speech_stream(VALIDATION_SEED)
-    landmarks = cached_track(stream, VALIDATION_CACHE, fresh)
-    found = measure_faps(landmarks, fps=FPS, neutral=(0, NEUTRAL), rig=model).stream[NEUTRAL:]
+    landmarks, brows = cached_track(stream, VALIDATION_CACHE, fresh)
+    found = measure_faps(landmarks, fps=FPS, neutral=(0, NEUTRAL), rig=model,
+                         brows=brows).stream[NEUTRAL:]
     truth = stream[NEUTRAL:]
     r = np.array([curve_correlation(truth.values[:, f - 1], found.values[:, f - 1])
                   for f in VALIDATION_FAPS])
@@ -318,14 +338,16 @@ def main() -> None:
     args = parser.parse_args()
     suffix = "" if args.push == PUSH else f"_p{args.push:g}"
     streams = [training_stream(args.frames, seed, push=args.push) for seed in args.seeds]
-    tracks = [cached_track(s, Path(str(CACHE).format(seed=f"{seed}{suffix}")), args.fresh)
+    cached = [cached_track(s, Path(str(CACHE).format(seed=f"{seed}{suffix}")), args.fresh)
               for s, seed in zip(streams, args.seeds, strict=True)]
+    tracks = [landmarks for landmarks, _ in cached]
     landmarks = np.concatenate(tracks)
+    brows = np.concatenate([b for _, b in cached])
     values = np.concatenate([s.values for s in streams])
-    lost = ~np.isfinite(landmarks).all(axis=(1, 2))
+    lost = ~(np.isfinite(landmarks).all(axis=(1, 2)) & np.isfinite(brows).all(axis=1))
     print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL),
-                              components=args.components)
+                              components=args.components, brows=brows[~lost])
     if not args.no_write:
         write_lip_rule(tracks, streams)
         lip_closure.cache_clear()  # the validation reads the rule just written

@@ -18,21 +18,23 @@ patch covers the same part of any face at any resolution.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from functools import cache
+from itertools import islice
 
 import numpy as np
 
 from facelib.data import json_data
 from facelib.errors import DataError, TrackingError
 from facelib.mpeg4 import FAPU_SCALE
-from facelib.tracking.headframe import Neutral, to_head_frame
+from facelib.tracking.headframe import Neutral, fill_gaps, neutral_face, to_head_frame
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.observation import ObservationModel, pose_correction
 from facelib.tracking.pose import HeadPose, euler_angles
 
-__all__ = ["N_FEATURES", "BrowPatches", "brow_features", "brow_patches", "sampling_poses"]
+__all__ = ["N_FEATURES", "BrowPatches", "brow_features", "brow_patches", "sampling_poses",
+           "track_brows"]
 
 N_FEATURES = 4
 """Features per frame: across and up shifts of the face's left inner brow, then the right's."""
@@ -220,3 +222,17 @@ def brow_features(images: Iterable[np.ndarray], landmarks: np.ndarray, patches: 
     if count != len(data):
         raise TrackingError(f"{count} images for {len(data)} landmark frames")
     return out
+
+
+def track_brows(open_frames: Callable[[], Iterable[np.ndarray]], landmarks: np.ndarray, *,
+                neutral: tuple[int, int], model: ObservationModel) -> np.ndarray:
+    """``(n, 4)`` :func:`brow_features` of a track: ``open_frames()`` gives its ``(H, W, 3)
+    uint8`` RGB frames from the first, each time it is called (it is called twice: once up
+    to the end of the ``neutral`` frames ``(start, stop)``, once for all);
+    ``(n, 478, 3)`` MediaPipe ``landmarks`` (NaN rows: no face) and ``model`` as for
+    :func:`~facelib.tracking.faps.measure_faps`."""
+    filled = fill_gaps(landmarks)[0]
+    rest = neutral_face(filled, layout=landmark_layout("mediapipe"), span=slice(*neutral))
+    start, stop = neutral
+    patches = brow_patches(islice(open_frames(), start, stop), filled[start:stop], rest, model)
+    return brow_features(open_frames(), landmarks, patches, rest, model)

@@ -21,8 +21,10 @@ from facelib.engine import Face, default_face
 from facelib.errors import ParameterError
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream
 from facelib.rendering import FaceRenderer, iter_frames
+from facelib.tracking.browimage import track_brows
 from facelib.tracking.faps import TrackedFaps, measure_faps
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+from facelib.tracking.observation import default_observation
 from facelib.tracking.pose import HEAD_FAP_IDS
 
 __all__ = ["LIPS_TOUCH", "ClosedLoop", "bilabial_closures", "closed_loop", "closure_events",
@@ -46,6 +48,8 @@ class ClosedLoop:
     landmarks: ``(n, 478, 3)`` MediaPipe landmarks of the render.
     frames: ``(n, H, W, 3) uint8`` the rendered frames (None unless ``keep_frames``).
     lead: ``(k, 478, 3)`` landmarks of the neutral lead frames (cut from ``landmarks``).
+    brows: ``(k + n, 4)`` the brows' image shifts of the lead and the stream's frames
+        (None when not read).
     """
 
     truth: FapStream
@@ -53,6 +57,7 @@ class ClosedLoop:
     landmarks: np.ndarray
     frames: np.ndarray | None
     lead: np.ndarray | None = None
+    brows: np.ndarray | None = None
 
     def remeasure(self, **options: Any) -> TrackedFaps:
         """The same landmarks measured again with other ``options`` of
@@ -60,6 +65,7 @@ class ClosedLoop:
         if self.lead is None or not len(self.lead):
             raise ParameterError("this closed loop kept no neutral lead frames")
         k = len(self.lead)
+        options.setdefault("brows", self.brows)
         found = measure_faps(np.concatenate([self.lead, self.landmarks]), fps=self.truth.fps,
                              neutral=(0, k), **options)
         return _trim(found, k)
@@ -116,11 +122,13 @@ def with_neutral_lead(stream: FapStream, frames: int) -> FapStream:
 
 def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: int = 8,
                 width: int = 640, height: int = 480, keep_frames: bool = False,
-                framing: str = "head", **options: Any) -> ClosedLoop:
+                framing: str = "head", brow_image: bool = True, **options: Any) -> ClosedLoop:
     """Render ``face`` (default head, framed as ``framing``: the whole head by default, as a
     webcam sees a person) driven by ``stream`` after ``neutral_frames`` neutral
     frames, track it with MediaPipe and recover the FAPs (``options`` go to
-    :func:`~facelib.tracking.faps.measure_faps`). The lead frames are cut from the result.
+    :func:`~facelib.tracking.faps.measure_faps`), the brows' image shifts read off the
+    frames as a video's are (:mod:`~facelib.tracking.browimage`) unless not
+    ``brow_image``. The lead frames are cut from the result.
     """
     face = default_face() if face is None else face
     full = with_neutral_lead(stream, neutral_frames)
@@ -132,15 +140,17 @@ def closed_loop(stream: FapStream, *, face: Face | None = None, neutral_frames: 
             found = tracker.detect(image)
             if found is not None:
                 points[i] = found.points
-            if keep_frames:
+            if keep_frames or brow_image:
                 rendered.append(image)
-    tracked = measure_faps(points, fps=stream.fps, neutral=(0, max(neutral_frames, 1)),
-                           **options)
+    neutral = (0, max(neutral_frames, 1))
+    brows = (track_brows(lambda: iter(rendered), points, neutral=neutral,
+                         model=default_observation()) if brow_image else None)
+    tracked = measure_faps(points, fps=stream.fps, neutral=neutral, brows=brows, **options)
     cut = slice(neutral_frames, None)
     return ClosedLoop(FapStream(stream.fps, stream.values, stream.mask),
                       _trim(tracked, neutral_frames), points[cut],
                       np.stack(rendered)[cut] if keep_frames else None,
-                      points[:neutral_frames])
+                      points[:neutral_frames], brows)
 
 
 def _trim(tracked: TrackedFaps, lead: int) -> TrackedFaps:

@@ -243,22 +243,25 @@ def checked_inputs(landmarks: np.ndarray, layout: str | LandmarkLayout,
 
 
 def _observe(frame: HeadFrame, model: ObservationModel, *, values: np.ndarray,
-             mask: np.ndarray) -> None:
-    """FAPs of ``model`` from the landmark motion (:mod:`~facelib.tracking.observation`)."""
-    found = solve_observation(model, frame.motion, frame.fapu)
+             mask: np.ndarray, brows: np.ndarray | None, angles: np.ndarray | None) -> None:
+    """FAPs of ``model`` from the landmark motion (:mod:`~facelib.tracking.observation`),
+    and the brows' image shifts when there are some."""
+    found = solve_observation(model, frame.motion, frame.fapu, brows=brows, angles=angles)
     values[:, model.faps - 1] = found
     mask[:, model.faps - 1] = True
 
 
-def _face_faps(frame: HeadFrame, layout: LandmarkLayout, model: Model | None
+def _face_faps(frame: HeadFrame, layout: LandmarkLayout, model: Model | None, *,
+               brows: np.ndarray | None = None, angles: np.ndarray | None = None
                ) -> tuple[np.ndarray, np.ndarray]:
-    """``(n, 84)`` values and mask of the face FAPs: the learned model, or eq. 4.16 (refined
-    by a rig fit) and the gaze of the pupils."""
+    """``(n, 84)`` values and mask of the face FAPs: the learned model (with the ``(n, 4)``
+    ``brows`` and ``(n, 3)`` ``angles`` its image part reads), or eq. 4.16 (refined by a rig
+    fit) and the gaze of the pupils."""
     n = len(frame.landmarks)
     values = np.zeros((n, N_FAPS))
     mask = np.zeros((n, N_FAPS), bool)
     if isinstance(model, ObservationModel):
-        _observe(frame, model, values=values, mask=mask)
+        _observe(frame, model, values=values, mask=mask, brows=brows, angles=angles)
         return values, mask
     moved = frame.points - frame.rest_points
     for col, row, axis, sign, unit in _plan(layout, frame.pose):  # eq. 4.16, per axis
@@ -288,22 +291,30 @@ landmarks, not of the whole track's."""
 
 
 def measure_frames(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkLayout,
-                   model: Model | None, lips: bool) -> MeasuredFrames:
+                   model: Model | None, lips: bool, brows: np.ndarray | None = None
+                   ) -> MeasuredFrames:
     """The face FAPs, head pose and (``lips``) inner-lip aperture of ``(n, K, D)`` gap-free
     landmarks (any frames of a track), measured against the track's ``neutral`` face
     (:func:`~facelib.tracking.headframe.neutral_face`) with ``model`` (see
-    :func:`measure_faps`'s ``rig``)."""
+    :func:`measure_faps`'s ``rig``) and the frames' ``(n, 4)`` brow image shifts, if any."""
     frame = to_head_frame(landmarks, neutral, layout=layout)
-    values, mask = _face_faps(frame, layout, model)
+    angles = None
     if frame.pose is not None:
         angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
         if isinstance(model, ObservationModel):  # the fit's learned error taken out
             angles += pose_correction(model, frame.motion, frame.fapu)
+    values, mask = _face_faps(frame, layout, model, brows=brows, angles=angles)
+    if angles is not None:
         values[:, [f - 1 for f in HEAD_FAP_IDS]] = angles / ANGLE_UNIT
         mask[:, [f - 1 for f in HEAD_FAP_IDS]] = True
     aperture = (lipclosure.inner_lip_aperture(frame, lipclosure.lip_closure())
                 if lips else None)
     return MeasuredFrames(values, mask, frame.pose, aperture)
+
+
+def _chunks(n: int) -> list[slice]:
+    """``n`` frames cut into chunks of :data:`_CHUNK_FRAMES`."""
+    return [slice(i, i + _CHUNK_FRAMES) for i in range(0, n, _CHUNK_FRAMES)]
 
 
 def _join(chunks: list[MeasuredFrames]) -> MeasuredFrames:
@@ -352,6 +363,21 @@ def settle_faps(values: np.ndarray, mask: np.ndarray, *,
     return values, mask
 
 
+def _brow_shifts(brows: np.ndarray | None, model: Model | None, n: int) -> np.ndarray | None:
+    """``(n, 4)`` brow image shifts with lost frames interpolated, or None without any or
+    when ``model`` cannot read them; ParameterError for another shape."""
+    if brows is None:
+        return None
+    shifts = np.asarray(brows, np.float64)
+    if shifts.shape != (n, 4):
+        raise ParameterError(f"brows must be ({n}, 4): 4 shifts per landmark frame, got "
+                             f"{shifts.shape}")
+    if (not isinstance(model, ObservationModel) or model.image_faps is None
+            or not np.isfinite(shifts).any()):
+        return None
+    return fill_gaps(shifts[:, None, :])[0][:, 0, :]
+
+
 def measure_faps(
     landmarks: np.ndarray,
     *,
@@ -364,6 +390,7 @@ def measure_faps(
     relations: bool = True,
     rig: Model | Literal["auto", "default", "observed"] | None = "auto",
     close_lips: bool = True,
+    brows: np.ndarray | None = None,
 ) -> TrackedFaps:
     """FAPs from landmark tracks; see the module docstring for the steps.
 
@@ -384,13 +411,15 @@ def measure_faps(
         observation model learned from renders (needs MediaPipe's 478 landmarks in 3-D;
         it also gives gaze); ``"default"`` (or a
         :class:`~facelib.tracking.rigfit.RigModel`) the default head's rig fitted to the
-        landmarks (needs the ``mediapipe`` layout); ``"auto"`` (the default) is
-        ``"observed"`` for 478 3-D MediaPipe landmarks and eq. 4.16 otherwise; None always
-        uses eq. 4.16.
+        landmarks (needs the ``mediapipe`` layout); ``"auto"`` (the default): ``"observed"``
+        for 478 3-D MediaPipe landmarks, else eq. 4.16; None: always eq. 4.16.
     close_lips: with a model (``rig`` not None) on MediaPipe landmarks, apply the mouth
         state read off the inner-lip aperture (:mod:`~facelib.tracking.lipclosure`): close
         the lips in the frames of a p, b or m and open them at least as far as the
         aperture shows in the others. False turns both off.
+    brows: ``(n_frames, 4)`` the brows' shifts read off the video's frames
+        (:mod:`~facelib.tracking.browimage`; NaN rows: no face): an observation model with
+        an image part (the packaged one) reads its brow FAPs with them, others ignore them.
     """
     rate = check_fps(fps)
     data, layout, model = checked_inputs(landmarks, layout, rig)
@@ -398,15 +427,16 @@ def measure_faps(
     if filled:
         warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
                                       f"{len(data)}; interpolated"), stacklevel=2)
+    shifts = _brow_shifts(brows, model, len(data))
     rest = neutral_face(data, layout=layout, span=neutral_span(neutral, len(data)), fapu=fapu)
     lips = close_lips and model is not None and layout.name == "mediapipe"
-    found = _join([measure_frames(data[i:i + _CHUNK_FRAMES], rest, layout=layout, model=model,
-                                  lips=lips) for i in range(0, len(data), _CHUNK_FRAMES)])
-    values = _smooth(found.values, found.mask, rate) if smooth else found.values
-    aperture = found.aperture
+    found = _join([measure_frames(data[cut], rest, layout=layout, model=model, lips=lips,
+                                  brows=None if shifts is None else shifts[cut])
+                   for cut in _chunks(len(data))])
     values, mask = settle_faps(
-        values, found.mask, states=states, relations=relations,
-        lips=None if aperture is None else (aperture, mouth_closed(aperture)))
+        _smooth(found.values, found.mask, rate) if smooth else found.values, found.mask,
+        states=states, relations=relations,
+        lips=None if found.aperture is None else (found.aperture, mouth_closed(found.aperture)))
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
 
 

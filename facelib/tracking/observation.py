@@ -28,12 +28,14 @@ alone reads as a nod of several degrees); tracking adds the estimate to the fitt
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -46,10 +48,13 @@ from facelib.tracking.headframe import head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.pose import HEAD_FAP_IDS, euler_angles
 
-__all__ = ["MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
-           "learn_observation", "load_observation", "pose_correction", "save_observation",
-           "solve_observation"]
+__all__ = ["IMAGE_FAPS", "MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
+           "image_inputs", "learn_observation", "load_observation", "pose_correction",
+           "save_observation", "solve_observation"]
 
+IMAGE_FAPS = (31, 32, 33, 34, 35, 36, 37, 38)
+"""FAPs the packaged model also reads off the brows' image shifts: the brows' raise and
+squeeze."""
 MODEL_FAPS = (3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 16, 17, 19, 20, 21, 22, 23, 24, 25, 26,
               31, 32, 33, 34, 35, 36, 37, 38, 41, 42, 51, 52, 53, 54, 55, 56, 57, 58, 59, 60,
               61, 62)
@@ -74,6 +79,11 @@ class ObservationModel:
         move the fit's stable points (a smile lifts the nostrils and the fit reads a nod).
     pose_bounds: ``(3, 2) float64`` or None: the range of that error in training, widened
         by a tenth.
+    image_faps: ``(b,) int64`` or None: FAPs read with the brows' image shifts too
+        (:mod:`~facelib.tracking.browimage`) when a video's frames give them.
+    image_estimator: ``(L, 2, b) float64`` or None: those FAPs' part of the landmark motion.
+    image_weights: ``(10, b) float64`` or None: their part of the 4 brow shifts (over ES0),
+        the 3 corrected head angles and the angles' squares (radians).
     """
 
     faps: np.ndarray
@@ -81,6 +91,9 @@ class ObservationModel:
     bounds: np.ndarray
     pose: np.ndarray | None = None
     pose_bounds: np.ndarray | None = None
+    image_faps: np.ndarray | None = None
+    image_estimator: np.ndarray | None = None
+    image_weights: np.ndarray | None = None
 
 
 def fap_lengths(faps: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
@@ -124,25 +137,43 @@ def _model_input(model: ObservationModel, displacements: np.ndarray,
     return _over_es(displacements, fapu).reshape(shape[0], -1)
 
 
+def _check_ids(faps: tuple[int, ...], name: str) -> np.ndarray:
+    """``(m,) int64`` distinct FAP ids; ParameterError naming ``name`` otherwise."""
+    ids = np.asarray(faps, np.int64)
+    if ids.ndim != 1 or not ids.size or len(set(ids.tolist())) != ids.size or not (
+            (ids >= 1) & (ids <= N_FAPS)).all():
+        raise ParameterError(f"{name} must be distinct FAP ids in 1-{N_FAPS}, got {faps!r}")
+    return ids
+
+
+def image_inputs(brows: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """``(n, 10)`` what the image part reads besides the landmark motion: the ``(n, 4)``
+    brow shifts (over ES0), the ``(n, 3)`` corrected pitch, yaw and roll (radians) and
+    their squares (the brow patches' registration drifts with the turn)."""
+    return np.hstack([brows, angles, angles ** 2])
+
+
 def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                       neutral: int | tuple[int, int] = 0,
                       faps: tuple[int, ...] = MODEL_FAPS,
-                      components: int = 60) -> ObservationModel:
+                      components: int = 60, brows: np.ndarray | None = None,
+                      image_faps: tuple[int, ...] = IMAGE_FAPS) -> ObservationModel:
     """Learn the model from ``(n, 478, 3)`` MediaPipe landmarks (image coordinates, no
     missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
 
     ``neutral``: the neutral frame(s); ``components``: principal components of the landmark
     motion the regression uses (fewer than frames); ``faps``: the distinct FAP ids (1-84) to
-    learn. ParameterError when ``values`` is not one row of 84 FAPs per landmark frame.
+    learn; ``brows``: ``(n, 4)`` the frames' brow image shifts
+    (:func:`~facelib.tracking.browimage.brow_features`), from which the ``image_faps``
+    (some of ``faps``) are learned a second time, with them. ParameterError when ``values``
+    is not one row of 84 FAPs per landmark frame, or ``brows`` not 4 finite numbers per
+    frame.
     """
     known = np.asarray(values, np.float64)
     if known.shape != (len(landmarks), N_FAPS):
         raise ParameterError(f"values must be ({len(landmarks)}, {N_FAPS}): the FAPs of each "
                              f"landmark frame, got {known.shape}")
-    ids = np.asarray(faps, np.int64)
-    if ids.ndim != 1 or not ids.size or len(set(ids.tolist())) != ids.size or not (
-            (ids >= 1) & (ids <= N_FAPS)).all():
-        raise ParameterError(f"faps must be distinct FAP ids in 1-{N_FAPS}, got {faps!r}")
+    ids = _check_ids(faps, "faps")
     moved, fapu, fitted = _normalised(landmarks, neutral)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
@@ -153,15 +184,37 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
     head = [f - 1 for f in HEAD_FAP_IDS]
     pose_error = known[:, head] * ANGLE_UNIT - fitted
-    target = np.hstack([target, pose_error])
     flat = moved.reshape(n, -1)
     centre = flat.mean(axis=0)
     basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:components]  # (k, 2L)
-    design = np.hstack([(flat - centre) @ basis.T, np.ones((n, 1))])
-    coef = np.linalg.lstsq(design, target, rcond=None)[0][:components]  # (k, m + 3)
+    scores = (flat - centre) @ basis.T
+    coef = _least_squares(scores, np.hstack([target, pose_error]))
     estimator = (basis.T @ coef).reshape(n_land, 2, len(ids) + 3)
-    return ObservationModel(ids, estimator[..., :-3], _range(truth), estimator[..., -3:],
-                            _range(pose_error))
+    model = ObservationModel(ids, estimator[..., :-3], _range(truth), estimator[..., -3:],
+                             _range(pose_error))
+    if brows is None:
+        return model
+    shifts = np.asarray(brows, np.float64)
+    if shifts.shape != (n, 4) or not np.isfinite(shifts).all():
+        raise ParameterError(f"brows must be ({n}, 4) finite shifts, got {shifts.shape}")
+    chosen = _check_ids(image_faps, "image_faps")
+    if not set(chosen.tolist()) <= set(ids.tolist()):
+        raise ParameterError(f"image_faps {image_faps!r} must be among faps")
+    angles = fitted + pose_correction(model, moved * (fapu["ES"] * FAPU_SCALE), fapu)
+    columns = [int(np.flatnonzero(ids == f)[0]) for f in chosen]
+    inputs = image_inputs(shifts, angles)
+    coef = _least_squares(np.hstack([scores, inputs]), target[:, columns])
+    return dataclasses.replace(
+        model, image_faps=chosen,
+        image_estimator=(basis.T @ coef[:components]).reshape(n_land, 2, len(chosen)),
+        image_weights=coef[components:])
+
+
+def _least_squares(design: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Coefficients ``(d, m)`` of the ``(n, d)`` design (with an intercept, then dropped: a
+    neutral frame reads 0) for the ``(n, m)`` target."""
+    ones = np.ones((len(design), 1))
+    return np.linalg.lstsq(np.hstack([design, ones]), target, rcond=None)[0][:-1]
 
 
 def _range(values: np.ndarray) -> np.ndarray:
@@ -172,13 +225,22 @@ def _range(values: np.ndarray) -> np.ndarray:
 
 
 def solve_observation(model: ObservationModel, displacements: np.ndarray,
-                      fapu: Mapping[str, float]) -> np.ndarray:
+                      fapu: Mapping[str, float], *, brows: np.ndarray | None = None,
+                      angles: np.ndarray | None = None) -> np.ndarray:
     """``(n, m) float64`` FAP values of ``model.faps`` from ``(n, L, 2)`` landmark
     displacements (neutral head frame, the unit of ``fapu``), each kept within
-    ``model.bounds``; 0 for a frame with no motion. ParameterError for another ``L`` than
-    the model's."""
+    ``model.bounds``; 0 for a frame with no motion. With ``(n, 4)`` ``brows`` (the brows'
+    image shifts over ES0) and ``(n, 3)`` corrected head ``angles`` (radians), the model's
+    image part reads its FAPs with them. ParameterError for another ``L`` than the
+    model's."""
     moved = _model_input(model, displacements, fapu)
     found = moved @ model.estimator.reshape(moved.shape[1], -1)
+    if brows is not None and angles is not None and model.image_faps is not None:
+        assert model.image_estimator is not None
+        assert model.image_weights is not None
+        columns = [int(np.flatnonzero(model.faps == f)[0]) for f in model.image_faps]
+        found[:, columns] = (moved @ model.image_estimator.reshape(moved.shape[1], -1)
+                             + image_inputs(brows, angles) @ model.image_weights)
     found *= fapu["ES"] * FAPU_SCALE / fap_lengths(model.faps, fapu)
     return np.clip(found, model.bounds[:, 0], model.bounds[:, 1])
 
@@ -195,15 +257,22 @@ def pose_correction(model: ObservationModel, displacements: np.ndarray,
     return np.clip(found, model.pose_bounds[:, 0], model.pose_bounds[:, 1])
 
 
+_OPTIONAL = (("pose", "pose_bounds"), ("image_faps", "image_estimator", "image_weights"))
+"""Arrays of a saved model that come all or none."""
+
+
 def save_observation(model: ObservationModel, path: str | os.PathLike[str]) -> Path:
     """Write ``model`` as a compressed ``.npz`` (float32), atomically."""
     buffer = io.BytesIO()
-    pose = np.zeros((0, 2, 3)) if model.pose is None else model.pose
-    pose_bounds = np.zeros((0, 2)) if model.pose_bounds is None else model.pose_bounds
-    np.savez_compressed(buffer, faps=model.faps.astype(np.int16),
-                        estimator=model.estimator.astype(np.float32),
-                        bounds=model.bounds.astype(np.float32),
-                        pose=pose.astype(np.float32), pose_bounds=pose_bounds.astype(np.float32))
+    arrays = {"faps": model.faps.astype(np.int16), "estimator": model.estimator,
+              "bounds": model.bounds}
+    for group in _OPTIONAL:
+        for key in group:
+            value = getattr(model, key)
+            arrays[key] = np.zeros(0) if value is None else value
+    payload: dict[str, Any] = {k: v.astype(np.int16 if "faps" in k else np.float32)
+                               for k, v in arrays.items()}
+    np.savez_compressed(buffer, **payload)
     with atomic_path(path) as temp:
         temp.write_bytes(buffer.getvalue())
     return Path(path)
@@ -211,28 +280,32 @@ def save_observation(model: ObservationModel, path: str | os.PathLike[str]) -> P
 
 def load_observation(source: str | os.PathLike[str] | io.BufferedIOBase, *,
                      name: str | None = None) -> ObservationModel:
-    """Read a model written by :func:`save_observation` (the pose arrays may be absent or
-    empty); DataError if it is malformed, naming ``name`` (default: the path, or
-    ``<stream>`` for an open stream)."""
+    """Read a model written by :func:`save_observation` (the pose and image arrays may be
+    absent or empty); DataError if it is malformed, naming ``name`` (default: the path,
+    or ``<stream>`` for an open stream)."""
     if name is None:
         name = str(source) if isinstance(source, (str, os.PathLike)) else "<stream>"
     try:
         with np.load(source, allow_pickle=False) as raw:
             arrays = {k: np.array(raw[k], np.float64) for k in ("faps", "estimator", "bounds")}
-            for key in ("pose", "pose_bounds"):
-                if key in raw.files and raw[key].size:
-                    arrays[key] = np.array(raw[key], np.float64)
+            for group in _OPTIONAL:
+                for key in group:
+                    if key in raw.files and raw[key].size:
+                        arrays[key] = np.array(raw[key], np.float64)
     except (OSError, KeyError, ValueError) as exc:
         raise DataError(f"not an observation model ({exc})", path=name) from exc
     if not _shapes_agree(arrays):
         shapes = ", ".join(f"{k} {v.shape}" for k, v in arrays.items())
         raise DataError(f"observation model arrays disagree in shape: {shapes} (want faps "
-                        "(m,), estimator (L, 2, m), bounds (m, 2) and, both or neither, pose "
-                        "(L, 2, 3) and pose_bounds (3, 2))", path=name)
+                        "(m,), estimator (L, 2, m), bounds (m, 2) and, all or none, pose "
+                        "(L, 2, 3) and pose_bounds (3, 2); image_faps (b,) among faps, "
+                        "image_estimator (L, 2, b) and image_weights (10, b))", path=name)
     for value in arrays.values():
         value.flags.writeable = False
-    return ObservationModel(arrays["faps"].astype(np.int64), arrays["estimator"],
-                            arrays["bounds"], arrays.get("pose"), arrays.get("pose_bounds"))
+    for key in ("faps", "image_faps"):
+        if key in arrays:
+            arrays[key] = arrays[key].astype(np.int64)
+    return ObservationModel(**arrays)
 
 
 def _shapes_agree(arrays: Mapping[str, np.ndarray]) -> bool:
@@ -240,13 +313,20 @@ def _shapes_agree(arrays: Mapping[str, np.ndarray]) -> bool:
     faps, estimator = arrays["faps"], arrays["estimator"]
     if faps.ndim != 1 or estimator.ndim != 3:
         return False
-    m = len(faps)
+    m, n_land = len(faps), estimator.shape[0]
     if estimator.shape[1:] != (2, m) or arrays["bounds"].shape != (m, 2):
         return False
-    if ("pose" in arrays) != ("pose_bounds" in arrays):
+    if any(0 < sum(k in arrays for k in group) < len(group) for group in _OPTIONAL):
         return False
-    return "pose" not in arrays or (arrays["pose"].shape == (estimator.shape[0], 2, 3)
-                                    and arrays["pose_bounds"].shape == (3, 2))
+    if "pose" in arrays and (arrays["pose"].shape != (n_land, 2, 3)
+                             or arrays["pose_bounds"].shape != (3, 2)):
+        return False
+    if "image_faps" not in arrays:
+        return True
+    b = arrays["image_faps"]
+    return (b.ndim == 1 and set(b.tolist()) <= set(faps.tolist())
+            and arrays["image_estimator"].shape == (n_land, 2, len(b))
+            and arrays["image_weights"].shape == (10, len(b)))
 
 
 @cache

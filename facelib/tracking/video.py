@@ -13,6 +13,7 @@ import subprocess
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
+from itertools import islice
 from pathlib import Path
 from typing import Any
 
@@ -20,11 +21,14 @@ import numpy as np
 
 from facelib.checks import check_count
 from facelib.errors import MissingExtraError, TrackingError, TrackingWarning
+from facelib.tracking.browimage import track_brows
 from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
+from facelib.tracking.headframe import neutral_span
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+from facelib.tracking.observation import ObservationModel, default_observation
 
 __all__ = ["VideoInfo", "VideoTrack", "extract_audio", "read_video", "track_video",
-           "track_video_faps"]
+           "track_video_faps", "video_brows"]
 
 
 @dataclass(frozen=True)
@@ -148,10 +152,33 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
     return VideoTrack(Path(path), info, np.stack(points), n_faces)
 
 
+def video_brows(path: str | os.PathLike[str], landmarks: np.ndarray, *,
+                neutral: tuple[int, int], model: ObservationModel | None = None
+                ) -> np.ndarray:
+    """``(n, 4)`` the brows' image shifts (:mod:`~facelib.tracking.browimage`) of the
+    video's first ``n`` frames, tracked as ``(n, 478, 3)`` ``landmarks`` with the neutral
+    frames ``(start, stop)``; ``model``: the observation model whose pose correction the
+    brows are sampled with (default: the packaged one). Reads the video twice more."""
+    def frames() -> Iterator[np.ndarray]:
+        return islice(read_video(path)[1], len(landmarks))
+
+    return track_brows(frames, landmarks, neutral=neutral,
+                       model=default_observation() if model is None else model)
+
+
 def track_video_faps(path: str | os.PathLike[str], *, max_frames: int | None = None,
                      **options: Any) -> tuple[VideoTrack, TrackedFaps]:
     """:func:`track_video`, then :func:`~facelib.tracking.faps.measure_faps` at the video's
-    frame rate (``options`` go to it: ``neutral``, ``fapu``, ``smooth``, ``states``)."""
+    frame rate (``options`` go to it: ``neutral``, ``fapu``, ``smooth``, ``states``) with
+    the brows' image shifts (:func:`video_brows`) for the learned model (``rig``
+    ``"auto"``, ``"observed"`` or an observation model) unless ``brows=None`` is given."""
     track = track_video(path, max_frames=max_frames)
+    rig = options.get("rig", "auto")
+    if "brows" not in options and (rig in ("auto", "observed")
+                                   or isinstance(rig, ObservationModel)):
+        span = neutral_span(options.get("neutral", 0), len(track.landmarks))
+        options["brows"] = video_brows(path, track.landmarks, neutral=(span.start, span.stop),
+                                       model=rig if isinstance(rig, ObservationModel) else None)
     return track, measure_faps(track.landmarks, fps=track.info.fps, layout="mediapipe",
                                **options)
+
