@@ -611,10 +611,22 @@ def _is_landmark_file(source: Path) -> bool:
     return source.is_dir() or source.suffix.lower() in (".csv", ".json", ".pts")
 
 
-def _track_source(args: argparse.Namespace, console: Console
-                  ) -> tuple[Any, float, str, Path | None, tuple[int, int]]:
-    """The landmarks, their rate and layout, the video (None for files and cameras) and
-    the neutral span of ``facelib track``'s source."""
+@dataclass(frozen=True)
+class _Tracked:
+    """What ``facelib track`` measures: ``(n, K, D)`` landmarks at ``fps`` in ``layout``,
+    the ``neutral`` span, the ``video`` (None for files and cameras) and the brows'
+    ``(n, 4)`` image shifts (None for landmark files)."""
+
+    landmarks: Any
+    fps: float
+    layout: str
+    neutral: tuple[int, int]
+    video: Path | None = None
+    brows: Any = None
+
+
+def _track_source(args: argparse.Namespace, console: Console) -> _Tracked:
+    """The landmarks of ``facelib track``'s source and what goes with them."""
     if args.camera is not None:
         return _track_camera(args, console)
     source = Path(args.source)
@@ -626,28 +638,20 @@ def _track_source(args: argparse.Namespace, console: Console
         layout = args.layout or file.layout
         if fps is None or layout is None:
             raise FacelibError(f"{source}: give --fps and --layout (the file does not say)")
-        return file.landmarks, fps, layout, None, _span(args.neutral)
-    from facelib.tracking.video import track_video
+        return _Tracked(file.landmarks, fps, layout, _span(args.neutral))
+    from facelib.tracking.video import track_video, video_brows
 
     track = track_video(source, max_frames=args.max_frames)
     console.status(f"tracked {len(track.landmarks)} frames of {source} ({track.info.width}x"
                    f"{track.info.height}, {track.info.fps:g} fps); no face in "
                    f"{len(track.lost_frames)}")
-    return track.landmarks, track.info.fps, "mediapipe", source, _span(args.neutral)
+    neutral = _span(args.neutral)
+    return _Tracked(track.landmarks, track.info.fps, "mediapipe", neutral, source,
+                    video_brows(source, track.landmarks, neutral=neutral))
 
 
-def _video_brows(video: Path | None, landmarks: Any, neutral: tuple[int, int]) -> Any:
-    """The brows' image shifts of a tracked video (None for other sources)."""
-    if video is None:
-        return None
-    from facelib.tracking.video import video_brows
-
-    return video_brows(video, landmarks, neutral=neutral)
-
-
-def _track_camera(args: argparse.Namespace, console: Console
-                  ) -> tuple[Any, float, str, None, tuple[int, int]]:
-    """``facelib track --camera``: record live, then the neutral span the live run used."""
+def _track_camera(args: argparse.Namespace, console: Console) -> _Tracked:
+    """``facelib track --camera``: record live; the neutral span the live run used."""
     import numpy as np
 
     from facelib.tracking.live import run_camera
@@ -666,7 +670,8 @@ def _track_camera(args: argparse.Namespace, console: Console
     console.status(f"recorded {len(recording.landmarks)} frames at {recording.fps:.3g} fps; "
                    f"no face in {len(recording.landmarks) - len(faces)}")
     neutral = (int(faces[0]), int(faces[args.neutral_frames - 1]) + 1)
-    return recording.landmarks, recording.fps, "mediapipe", None, neutral
+    return _Tracked(recording.landmarks, recording.fps, "mediapipe", neutral,
+                    brows=recording.brows)
 
 
 def _track(args: argparse.Namespace, console: Console) -> int:
@@ -680,17 +685,18 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     if args.render and (args.camera is not None or _is_landmark_file(Path(args.source))):
         raise FacelibError("--render needs a video source (the mirror shows it; live, the "
                            "window is the mirror)")
-    landmarks, fps, layout, video, neutral = _track_source(args, console)
+    source = _track_source(args, console)
+    landmarks, fps = source.landmarks, source.fps
     states = None
-    options: dict[str, Any] = {"neutral": neutral, "smooth": not args.no_smooth}
     if args.pucker:
         mask = np.zeros(len(landmarks), bool)
         for text in args.pucker:
             start, stop = _span(text)
             mask[start:stop] = True
         states = {"pucker": mask}
-    result = measure_faps(landmarks, fps=fps, layout=layout, states=states,
-                          brows=_video_brows(video, landmarks, neutral), **options)
+    result = measure_faps(landmarks, fps=fps, layout=source.layout, states=states,
+                          neutral=source.neutral, smooth=not args.no_smooth,
+                          brows=source.brows)
     console.status("user FAPU (pixels): " + ", ".join(f"{k}0={v * 1024:.1f}"
                                              for k, v in result.fapu.items() if k != "AU"))
     stream = result.stream
@@ -700,10 +706,10 @@ def _track(args: argparse.Namespace, console: Console) -> int:
         from facelib.tracking.files import write_landmarks_csv
 
         console.status(f"wrote {write_landmarks_csv(args.landmarks_out, landmarks, fps=fps)}")
-    if args.render and video is not None:
+    if args.render and source.video is not None:
         from facelib.tracking.mirror import render_mirror
 
-        out = render_mirror(video, result.stream, args.render, face=_face(args.face),
+        out = render_mirror(source.video, result.stream, args.render, face=_face(args.face),
                             landmarks=landmarks if args.show_landmarks else None)
         console.status(f"wrote {out}")
     return EXIT_OK

@@ -18,13 +18,14 @@ stream address, a video file played as if live) and shows the mirror in a window
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
 from facelib.checks import check_count, check_fps
 from facelib.errors import ParameterError, TrackingError
+from facelib.tracking.browimage import BrowPatches, brow_features, brow_patches
 from facelib.tracking.faps import (
     FilterBand,
     Model,
@@ -37,6 +38,7 @@ from facelib.tracking.faps import (
 from facelib.tracking.headframe import Neutral, neutral_face
 from facelib.tracking.layouts import LandmarkLayout
 from facelib.tracking.mediapipe import N_LANDMARKS
+from facelib.tracking.observation import ObservationModel
 from facelib.tracking.smoothing import EuroState, one_euro_step
 
 __all__ = ["LiveFaps", "LiveRecording", "run_camera"]
@@ -61,6 +63,8 @@ class LiveFaps:
         self._smooth = smooth
         self._close_lips = close_lips
         self._collected: list[np.ndarray] = []
+        self._images: list[np.ndarray | None] = []
+        self._patches: BrowPatches | None = None
         self._neutral: Neutral | None = None
         self._layout: LandmarkLayout | None = None
         self._model: Model | None = None
@@ -70,17 +74,24 @@ class LiveFaps:
         self._last: np.ndarray | None = None
         self.mask: np.ndarray | None = None
         """``(84,) bool`` the FAPs each frame's values hold (None until the first)."""
+        self.brows: np.ndarray | None = None
+        """``(4,)`` the last frame's brow image shifts (None when not read)."""
+        self.neutral_brows: np.ndarray | None = None
+        """``(neutral_frames, 4)`` the neutral frames' brow image shifts, once read."""
 
     @property
     def neutral(self) -> Neutral | None:
         """The neutral face, once its frames are in."""
         return self._neutral
 
-    def push(self, landmarks: np.ndarray | None) -> np.ndarray | None:
+    def push(self, landmarks: np.ndarray | None, image: np.ndarray | None = None
+             ) -> np.ndarray | None:
         """The ``(84,) float64`` FAP values of the next frame from its ``(K, D)`` landmarks
         (image coordinates as for :func:`~facelib.tracking.faps.measure_faps`; None or
         NaN: no face): None while the neutral frames are being collected, the last values
-        again for a frame without a face."""
+        again for a frame without a face. With the frame's ``(H, W, 3) uint8`` RGB
+        ``image`` (every frame's, the neutral ones' included), the brows are also read off
+        the image (:mod:`~facelib.tracking.browimage`), as for a video."""
         if landmarks is None or not np.isfinite(landmarks).all():
             return None if self._last is None else self._last.copy()
         frame = np.asarray(landmarks, np.float64)
@@ -89,13 +100,18 @@ class LiveFaps:
         if frame.shape != first.shape:
             raise TrackingError(f"landmarks of shape {frame.shape} after ones of {first.shape}")
         if self._neutral is None:
-            self._collect(frame)
+            self._collect(frame, image)
             return None
         assert self._layout is not None
         row = frame[None]
         lips = self._close_lips and self._model is not None and self._layout.name == "mediapipe"
+        brows = None
+        if self._patches is not None and image is not None:
+            assert isinstance(self._model, ObservationModel)
+            brows = brow_features([image], row, self._patches, self._neutral, self._model)
+        self.brows = None if brows is None else brows[0]
         found = measure_frames(row, self._neutral, layout=self._layout, model=self._model,
-                               lips=lips)
+                               lips=lips, brows=brows)
         values = found.values[0]
         if self._smooth:
             values = self._filter(values, found.mask[0])
@@ -108,15 +124,24 @@ class LiveFaps:
         self._last, self.mask = out[0], mask[0]
         return out[0].copy()
 
-    def _collect(self, landmarks: np.ndarray) -> None:
-        """Keep a neutral frame; with the last one in, fix the neutral, layout and model."""
+    def _collect(self, landmarks: np.ndarray, image: np.ndarray | None) -> None:
+        """Keep a neutral frame (and its image); with the last one in, fix the neutral,
+        layout and model, and the brow patches when every neutral frame had an image and
+        the model reads them."""
         self._collected.append(landmarks)
+        self._images.append(image)
         if len(self._collected) < self.neutral_frames:
             return
         data, self._layout, self._model = checked_inputs(np.stack(self._collected),
                                                          **self._options)
         self._neutral = neutral_face(data, layout=self._layout, span=slice(0, len(data)))
-        self._collected = []
+        images = [i for i in self._images if i is not None]
+        if (isinstance(self._model, ObservationModel) and self._model.image_faps is not None
+                and len(images) == len(data)):
+            self._patches = brow_patches(images, data, self._neutral, self._model)
+            self.neutral_brows = brow_features(images, data, self._patches, self._neutral,
+                                               self._model)
+        self._collected, self._images = [], []
 
     def _filter(self, values: np.ndarray, measured: np.ndarray) -> np.ndarray:
         """``(84,)`` values through the causal One Euro filter over the ``(84,) bool``
@@ -142,12 +167,14 @@ class LiveRecording:
     ----------
     landmarks: ``(n, 478, 3) float64`` MediaPipe landmarks per frame (NaN: no face).
     values: ``(n, 84) float64`` the FAPs shown live (NaN while the neutral was collected).
+    brows: ``(n, 4) float64`` the brows' image shifts (NaN where not read).
     fps: the frames' rate: the source's, or for a camera (and a source that does not say)
         the rate frames were read at (30 for a single frame that does not say).
     """
 
     landmarks: np.ndarray
     values: np.ndarray
+    brows: np.ndarray
     fps: float
 
 
@@ -202,35 +229,66 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
         raise TrackingError(f"cannot open the camera or stream {source!r}")
     nominal = float(capture.get(cv2.CAP_PROP_FPS) or 0.0)
     live = LiveFaps(fps=nominal if nominal > 0 else 30.0, neutral_frames=neutral_frames)
-    points: list[np.ndarray] = []
-    shown: list[np.ndarray] = []
-    times: list[float] = []
+    record = _Recorder()
     try:
         with FaceMeshTracker(video=True, max_faces=1) as tracker, \
                 _Avatar(face, enabled=window) as avatar:
-            while limit is None or len(points) < limit:
+            while limit is None or len(record.points) < limit:
                 ok, bgr = capture.read()
                 if not ok:
                     break
-                times.append(time.perf_counter())
-                found = tracker.detect(np.ascontiguousarray(bgr[..., ::-1]))
-                values = live.push(None if found is None else found.points)
-                points.append(np.full((N_LANDMARKS, 3), np.nan) if found is None
-                              else found.points)
-                shown.append(np.full(84, np.nan) if values is None else values)
+                record.times.append(time.perf_counter())
+                image = np.ascontiguousarray(bgr[..., ::-1])
+                found = tracker.detect(image)
+                collecting = live.neutral is None
+                values = live.push(None if found is None else found.points, image)
+                record.add(None if found is None else found.points, values, live,
+                           collecting=collecting)
                 if window and not avatar.show(bgr, values, live):
                     break
     except KeyboardInterrupt:
         pass
     finally:
         capture.release()
-    if not points:
+    if not record.points:
         raise TrackingError(f"no frame from {source!r}")
     camera = isinstance(source, int) or str(source).startswith("/dev/")
-    if (camera or nominal <= 0) and len(times) > 1 and times[-1] > times[0]:
-        nominal = (len(times) - 1) / (times[-1] - times[0])  # the rate frames came at
-    fps = nominal if nominal > 0 else 30.0
-    return LiveRecording(np.stack(points), np.stack(shown), fps)
+    return record.finish(None if camera or nominal <= 0 else nominal)
+
+
+@dataclass
+class _Recorder:
+    """What a live session keeps frame by frame (mutated only by :func:`run_camera`)."""
+
+    points: list[np.ndarray] = field(default_factory=list)
+    shown: list[np.ndarray] = field(default_factory=list)
+    brows: list[np.ndarray] = field(default_factory=list)
+    neutral_rows: list[int] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)
+
+    def add(self, points: np.ndarray | None, values: np.ndarray | None, live: LiveFaps, *,
+            collecting: bool) -> None:
+        """Keep a frame's landmarks (None: no face), the FAPs shown (None: none yet) and the
+        brow shifts ``live`` read; while ``collecting`` the neutral, note its frames and
+        fill in their shifts once it is in."""
+        self.points.append(np.full((N_LANDMARKS, 3), np.nan) if points is None else points)
+        self.shown.append(np.full(84, np.nan) if values is None else values)
+        self.brows.append(np.full(4, np.nan) if collecting or points is None
+                          or live.brows is None else live.brows)
+        if collecting and points is not None:
+            self.neutral_rows.append(len(self.brows) - 1)
+            if live.neutral_brows is not None:
+                for row, shifts in zip(self.neutral_rows, live.neutral_brows, strict=True):
+                    self.brows[row] = shifts
+
+    def finish(self, fps: float | None) -> LiveRecording:
+        """The recording at ``fps``, or (None) at the rate the frames came at."""
+        times = self.times
+        if fps is None:
+            fps = ((len(times) - 1) / (times[-1] - times[0])
+                   if len(times) > 1 and times[-1] > times[0] else 30.0)
+        return LiveRecording(np.stack(self.points), np.stack(self.shown),
+                             np.stack(self.brows), fps)
 
 
 class _Avatar:

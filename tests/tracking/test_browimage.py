@@ -42,7 +42,8 @@ def brow_stream(n: int) -> FapStream:
 
 @pytest.fixture(scope="module")
 def rendered():
-    """Frames, landmarks and brow shifts of :func:`brow_stream` on the default head."""
+    """The stream, landmarks, brow shifts and frames of :func:`brow_stream` on the default
+    head."""
     if importlib.util.find_spec("pyrender") is None:  # importing it would pick OpenGL
         pytest.skip("needs the render extra")
     pytest.importorskip("mediapipe")
@@ -60,12 +61,12 @@ def rendered():
         landmarks = np.stack([tracker.detect(f).points for f in frames])
     brows = track_brows(lambda: iter(frames), landmarks, neutral=(0, NEUTRAL),
                         model=default_observation())
-    return stream, landmarks, brows
+    return stream, landmarks, brows, frames
 
 
 @pytest.mark.render
 def test_a_rendered_brow_raise_comes_back(rendered):
-    stream, landmarks, brows = rendered
+    stream, landmarks, brows, _frames = rendered
     assert np.abs(brows[:NEUTRAL]).max() < 0.012  # the neutral frames: under a pixel
     raised = stream.values[:, 30]
     for up in (1, 3):  # left and right brow
@@ -81,7 +82,7 @@ def test_a_rendered_brow_raise_comes_back(rendered):
 
 @pytest.mark.render
 def test_a_squeeze_moves_the_brows_toward_each_other_and_down(rendered):
-    stream, _, brows = rendered
+    stream, _, brows, _ = rendered
     squeezed = int(np.argmax(stream.values[:, 36]))
     # across = toward the face's left (+x): the left brow moves right (-), the right left (+)
     assert brows[squeezed, 0] < -0.05 and brows[squeezed, 2] > 0.05
@@ -90,7 +91,7 @@ def test_a_squeeze_moves_the_brows_toward_each_other_and_down(rendered):
 
 @pytest.mark.render
 def test_a_head_turn_alone_reads_as_little_raise(rendered):
-    stream, _, brows = rendered
+    stream, _, brows, _ = rendered
     turned = np.abs(stream.values[:, 48]) > 0
     assert np.radians(14) < stream.values[turned, 48].max() * ANGLE_UNIT
     raise_peak = brows[:24, [1, 3]].max()
@@ -101,7 +102,7 @@ def test_a_head_turn_alone_reads_as_little_raise(rendered):
 
 @pytest.mark.render
 def test_the_packaged_model_reads_the_brows_with_them(rendered):
-    stream, landmarks, brows = rendered
+    stream, landmarks, brows, _frames = rendered
     found = measure_faps(landmarks, fps=25, neutral=(0, NEUTRAL), brows=brows).stream.values
     plain = measure_faps(landmarks, fps=25, neutral=(0, NEUTRAL)).stream.values
     truth = stream.values
@@ -165,3 +166,16 @@ def test_brows_of_another_length_are_named():
     with pytest.raises(ParameterError, match="brows must be"):
         learn_observation(landmarks, random_stream(10, seed=1), components=3,
                           brows=np.full((10, 4), np.nan))
+
+
+@pytest.mark.render
+def test_live_faps_read_the_brows_as_the_recorded_path(rendered):
+    from facelib.tracking.live import LiveFaps
+
+    _stream, landmarks, brows, frames = rendered
+    live = LiveFaps(fps=25, neutral_frames=NEUTRAL, smooth=False)
+    rows = [live.push(points, image) for points, image in zip(landmarks, frames, strict=True)]
+    recorded = measure_faps(landmarks, fps=25, neutral=(0, NEUTRAL), smooth=False,
+                            brows=brows).stream.values
+    np.testing.assert_allclose(np.stack(rows[NEUTRAL:]), recorded[NEUTRAL:], atol=1e-9)
+    np.testing.assert_allclose(live.neutral_brows, brows[:NEUTRAL], atol=1e-12)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from facelib.engine import default_face
-from facelib.errors import DataError, ParameterError
+from facelib.errors import DataError, ParameterError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream
 from facelib.tracking.embedding import default_head_embedding
 from facelib.tracking.faps import measure_faps
@@ -205,9 +205,11 @@ def test_long_tracks_are_measured_in_chunks_with_the_same_result(rig, monkeypatc
     values = random_stream(40, seed=5)
     landmarks = camera(values)
     landmarks[17:20] = np.nan  # a lost stretch across a chunk boundary
-    whole = measure_faps(landmarks, fps=25.0, neutral=(0, 4), rig=rig)
+    with pytest.warns(TrackingWarning, match="no face in frames 17-19"):
+        whole = measure_faps(landmarks, fps=25.0, neutral=(0, 4), rig=rig)
     monkeypatch.setattr(faps, "_CHUNK_FRAMES", 7)
-    cut = measure_faps(landmarks, fps=25.0, neutral=(0, 4), rig=rig)
+    with pytest.warns(TrackingWarning, match="no face in frames 17-19"):
+        cut = measure_faps(landmarks, fps=25.0, neutral=(0, 4), rig=rig)
     np.testing.assert_allclose(cut.stream.values, whole.stream.values, atol=1e-9)
     np.testing.assert_array_equal(cut.stream.mask, whole.stream.mask)
     np.testing.assert_allclose(cut.pose.rotation, whole.pose.rotation, atol=1e-12)
