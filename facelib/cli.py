@@ -680,13 +680,18 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     from facelib.tracking.faps import measure_faps
 
     if (args.source is None) == (args.camera is None):
-        raise FacelibError("give a source (a video or landmark file) or --camera, not both")
+        raise FacelibError("give a source (a video or landmark file) or --camera" + (
+            ", not both" if args.source is not None else ""))
     _check_suffix(args.output, (".fap",), "track")
     if args.render and (args.camera is not None or _is_landmark_file(Path(args.source))):
         raise FacelibError("--render needs a video source (the mirror shows it; live, the "
                            "window is the mirror)")
     source = _track_source(args, console)
     landmarks, fps = source.landmarks, source.fps
+    if args.landmarks_out:  # first: a live session's landmarks survive a failed measure
+        from facelib.tracking.files import write_landmarks_csv
+
+        console.status(f"wrote {write_landmarks_csv(args.landmarks_out, landmarks, fps=fps)}")
     states = None
     if args.pucker:
         mask = np.zeros(len(landmarks), bool)
@@ -702,10 +707,6 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     stream = result.stream
     _emit_text(format_fap(stream, dialect=args.dialect, name=Path(args.output).stem),
                args.output, console, f"({stream.n_frames} frames, {stream.duration:.2f} s)")
-    if args.landmarks_out:
-        from facelib.tracking.files import write_landmarks_csv
-
-        console.status(f"wrote {write_landmarks_csv(args.landmarks_out, landmarks, fps=fps)}")
     if args.render and source.video is not None:
         from facelib.tracking.mirror import render_mirror
 

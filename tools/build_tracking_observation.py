@@ -220,7 +220,9 @@ def speech_stream(seed: int) -> tuple[FapStream, list[tuple[float, float]]]:
 def render_and_track(stream: FapStream) -> tuple[np.ndarray, np.ndarray]:
     """``(n, 478, 3)`` MediaPipe landmarks of the default head rendered with ``stream`` and
     ``(n, 4)`` the brows' image shifts (:mod:`facelib.tracking.browimage`, against the
-    first ``NEUTRAL`` frames, with the packaged model's pose correction)."""
+    first ``NEUTRAL`` frames). The shifts are sampled through the packaged model's pose
+    correction, the one being rebuilt: its pose part is learned from these same streams
+    and changes little from one build to the next (rebuild twice after changing it)."""
     from facelib.rendering import FaceRenderer, iter_frames
     from facelib.tracking.browimage import N_FEATURES, brow_features, brow_patches
     from facelib.tracking.headframe import neutral_face
@@ -240,6 +242,8 @@ def render_and_track(stream: FapStream) -> tuple[np.ndarray, np.ndarray]:
             if i < NEUTRAL:
                 lead.append(image)
                 if i == NEUTRAL - 1:
+                    if not np.isfinite(points[:NEUTRAL]).all():
+                        raise SystemExit("MediaPipe lost the face in a neutral lead frame")
                     rest = neutral_face(points[:NEUTRAL], layout=landmark_layout("mediapipe"),
                                         span=slice(0, NEUTRAL))
                     patches = brow_patches(lead, points[:NEUTRAL], rest, model)

@@ -28,7 +28,13 @@ import numpy as np
 from facelib.data import json_data
 from facelib.errors import DataError, TrackingError
 from facelib.mpeg4 import FAPU_SCALE
-from facelib.tracking.headframe import Neutral, fill_gaps, neutral_face, to_head_frame
+from facelib.tracking.headframe import (
+    Neutral,
+    fill_gaps,
+    neutral_face,
+    neutral_span,
+    to_head_frame,
+)
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.observation import ObservationModel, pose_correction
 from facelib.tracking.pose import HeadPose, euler_angles
@@ -80,12 +86,10 @@ class BrowPatches:
     regions: ``(2, rh, rw, 3) float64`` points on the neutral face (face frame, the
         landmarks' unit) sampled in every frame: each brow's patch widened by the search.
     templates: ``(2, th, tw) float32`` the neutral frames' mean grey patch of each brow.
-    step: the grid's spacing (the landmarks' unit).
     """
 
     regions: np.ndarray
     templates: np.ndarray
-    step: float
 
 
 def _grey(image: np.ndarray) -> np.ndarray:
@@ -124,9 +128,9 @@ def sampling_poses(landmarks: np.ndarray, neutral: Neutral, model: ObservationMo
     return HeadPose(solved[:, 0], rotation, translation)
 
 
-def _grids(neutral: Neutral) -> tuple[np.ndarray, np.ndarray, float]:
+def _grids(neutral: Neutral) -> tuple[np.ndarray, np.ndarray]:
     """Each brow's patch grid ``(2, th, tw, 3)`` and search region ``(2, rh, rw, 3)`` on the
-    neutral face (rows from the top down), and the spacing, in the landmarks' unit."""
+    neutral face (rows from the top down, the landmarks' unit)."""
     from scipy.interpolate import LinearNDInterpolator
 
     cfg = _settings()
@@ -151,7 +155,7 @@ def _grids(neutral: Neutral) -> tuple[np.ndarray, np.ndarray, float]:
             out.append(np.stack([gx, gy, depth(gx, gy)], axis=-1))
     if not np.isfinite(np.concatenate([r.ravel() for r in regions])).all():
         raise TrackingError("the brow patches reach beyond the neutral face's landmarks")
-    return np.stack(patches), np.stack(regions), step
+    return np.stack(patches), np.stack(regions)
 
 
 def _sample(grey: np.ndarray, points: np.ndarray, pose: HeadPose, i: int) -> np.ndarray:
@@ -170,17 +174,20 @@ def brow_patches(images: Iterable[np.ndarray], landmarks: np.ndarray, neutral: N
     """The :class:`BrowPatches` of the neutral frames: their ``(H, W, 3) uint8`` RGB
     ``images`` and ``(k, 478, 3)`` gap-free MediaPipe ``landmarks``, measured against the
     track's ``neutral`` face with ``model``'s pose correction."""
-    patch, regions, step = _grids(neutral)
+    patch, regions = _grids(neutral)
     pose = sampling_poses(landmarks, neutral, model)
     sums = np.zeros(patch.shape[:3], np.float64)
     count = 0
     for i, image in enumerate(images):
+        if i >= len(landmarks):
+            raise TrackingError(f"more neutral images than the {len(landmarks)} landmark "
+                                "frames")
         grey = _grey(image)
         sums += np.stack([_sample(grey, p, pose, i) for p in patch])
         count += 1
     if count != len(landmarks):
         raise TrackingError(f"{count} neutral images for {len(landmarks)} landmark frames")
-    return BrowPatches(regions, (sums / count).astype(np.float32), step)
+    return BrowPatches(regions, (sums / count).astype(np.float32))
 
 
 def _peak(scores: np.ndarray, at: int) -> float:
@@ -193,34 +200,50 @@ def _peak(scores: np.ndarray, at: int) -> float:
     return 0.0
 
 
+_CHUNK_FRAMES = 1024
+"""Frames whose sampling poses are fitted at a time (a long track is never copied whole)."""
+
+
 def brow_features(images: Iterable[np.ndarray], landmarks: np.ndarray, patches: BrowPatches,
                   neutral: Neutral, model: ObservationModel) -> np.ndarray:
     """``(n, 4) float64`` each inner brow's shift across (toward the face's left) and up
     from the neutral, in the head's frame over ES0 (left brow, then right), from ``n``
     ``(H, W, 3) uint8`` RGB ``images`` and their ``(n, 478, 3)`` MediaPipe ``landmarks``
-    (NaN rows: no face; NaN features there)."""
-    import cv2
-
+    (NaN rows: no face; NaN features there). TrackingError unless there is one image per
+    landmark frame."""
     data = np.asarray(landmarks, np.float64)
     found = np.asarray(np.isfinite(data).reshape(len(data), -1).all(axis=1))
     out = np.full((len(data), N_FEATURES), np.nan)
-    pose = sampling_poses(np.where(found[:, None, None], data, neutral.image_rest * [1, -1, -1]),
-                          neutral, model)
-    cfg = _settings()
     count = 0
     for i, image in enumerate(images):
+        if i >= len(data):
+            raise TrackingError(f"more images than the {len(data)} landmark frames")
         count += 1
-        if not found[i]:
-            continue
-        grey = _grey(image)
-        for side in range(2):
-            region = _sample(grey, patches.regions[side], pose, i)
-            scores = cv2.matchTemplate(region, patches.templates[side], cv2.TM_CCOEFF_NORMED)
-            row, col = (int(k) for k in np.unravel_index(int(np.argmax(scores)), scores.shape))
-            out[i, 2 * side] = (col + _peak(scores[row, :], col)) * cfg.step - cfg.across
-            out[i, 2 * side + 1] = cfg.up - (row + _peak(scores[:, col], row)) * cfg.step
+        if i % _CHUNK_FRAMES == 0:  # the poses of the next chunk of frames
+            chunk = data[i:i + _CHUNK_FRAMES]
+            faces = found[i:i + _CHUNK_FRAMES, None, None]
+            pose = sampling_poses(np.where(faces, chunk, neutral.image_rest * [1, -1, -1]),
+                                  neutral, model)
+        if found[i]:
+            out[i] = _register(_grey(image), patches, pose, i % _CHUNK_FRAMES)
     if count != len(data):
         raise TrackingError(f"{count} images for {len(data)} landmark frames")
+    return out
+
+
+def _register(grey: np.ndarray, patches: BrowPatches, pose: HeadPose, i: int) -> np.ndarray:
+    """``(4,)`` the brows' shifts (across, up; over ES0) in the ``(H, W)`` grey frame seen
+    through ``pose``'s frame ``i``."""
+    import cv2
+
+    cfg = _settings()
+    out = np.empty(N_FEATURES)
+    for side in range(2):
+        region = _sample(grey, patches.regions[side], pose, i)
+        scores = cv2.matchTemplate(region, patches.templates[side], cv2.TM_CCOEFF_NORMED)
+        row, col = (int(k) for k in np.unravel_index(int(np.argmax(scores)), scores.shape))
+        out[2 * side] = (col + _peak(scores[row, :], col)) * cfg.step - cfg.across
+        out[2 * side + 1] = cfg.up - (row + _peak(scores[:, col], row)) * cfg.step
     return out
 
 
@@ -232,7 +255,8 @@ def track_brows(open_frames: Callable[[], Iterable[np.ndarray]], landmarks: np.n
     ``(n, 478, 3)`` MediaPipe ``landmarks`` (NaN rows: no face) and ``model`` as for
     :func:`~facelib.tracking.faps.measure_faps`."""
     filled = fill_gaps(landmarks)[0]
-    rest = neutral_face(filled, layout=landmark_layout("mediapipe"), span=slice(*neutral))
-    start, stop = neutral
+    span = neutral_span(neutral, len(filled))
+    rest = neutral_face(filled, layout=landmark_layout("mediapipe"), span=span)
+    start, stop = span.start, span.stop
     patches = brow_patches(islice(open_frames(), start, stop), filled[start:stop], rest, model)
     return brow_features(open_frames(), landmarks, patches, rest, model)

@@ -373,7 +373,7 @@ def _brow_shifts(brows: np.ndarray | None, model: Model | None, n: int) -> np.nd
         raise ParameterError(f"brows must be ({n}, 4): 4 shifts per landmark frame, got "
                              f"{shifts.shape}")
     if (not isinstance(model, ObservationModel) or model.image_faps is None
-            or not np.isfinite(shifts).any()):
+            or not np.isfinite(shifts).all(axis=1).any()):
         return None
     return fill_gaps(shifts[:, None, :])[0][:, 0, :]
 

@@ -3,7 +3,8 @@ first seed's Virtual Mirror, section 5.2, live).
 
 :func:`~facelib.tracking.faps.measure_faps` sees a whole recorded track: it fills lost
 frames from both sides and filters both ways. Live, a frame's FAPs are due as soon as its
-landmarks are, so :class:`LiveFaps` differs in four ways and in nothing else:
+landmarks are, so :class:`LiveFaps` differs in four ways and measures alike otherwise
+(the brows read off each frame's image too, when it is given):
 
 - the neutral face is the first ``neutral_frames`` frames with a face (hold still for a
   second when the camera starts);

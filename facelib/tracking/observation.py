@@ -174,6 +174,10 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
         raise ParameterError(f"values must be ({len(landmarks)}, {N_FAPS}): the FAPs of each "
                              f"landmark frame, got {known.shape}")
     ids = _check_ids(faps, "faps")
+    if brows is not None and (np.shape(brows) != (len(known), 4)
+                              or not np.isfinite(brows).all()):
+        raise ParameterError(f"brows must be ({len(known)}, 4) finite shifts, got "
+                             f"{np.shape(brows)}")
     moved, fapu, fitted = _normalised(landmarks, neutral)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
@@ -195,8 +199,6 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     if brows is None:
         return model
     shifts = np.asarray(brows, np.float64)
-    if shifts.shape != (n, 4) or not np.isfinite(shifts).all():
-        raise ParameterError(f"brows must be ({n}, 4) finite shifts, got {shifts.shape}")
     chosen = _check_ids(image_faps, "image_faps")
     if not set(chosen.tolist()) <= set(ids.tolist()):
         raise ParameterError(f"image_faps {image_faps!r} must be among faps")
@@ -235,7 +237,12 @@ def solve_observation(model: ObservationModel, displacements: np.ndarray,
     model's."""
     moved = _model_input(model, displacements, fapu)
     found = moved @ model.estimator.reshape(moved.shape[1], -1)
-    if brows is not None and angles is not None and model.image_faps is not None:
+    if brows is not None and model.image_faps is not None:
+        if angles is None or np.shape(brows) != (len(moved), 4) or np.shape(angles) != (
+                len(moved), 3):
+            raise ParameterError(f"the image part reads brows ({len(moved)}, 4) with angles "
+                                 f"({len(moved)}, 3), got {np.shape(brows)} and "
+                                 f"{None if angles is None else np.shape(angles)}")
         assert model.image_estimator is not None
         assert model.image_weights is not None
         columns = [int(np.flatnonzero(model.faps == f)[0]) for f in model.image_faps]

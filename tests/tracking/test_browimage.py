@@ -179,3 +179,33 @@ def test_live_faps_read_the_brows_as_the_recorded_path(rendered):
                             brows=brows).stream.values
     np.testing.assert_allclose(np.stack(rows[NEUTRAL:]), recorded[NEUTRAL:], atol=1e-9)
     np.testing.assert_allclose(live.neutral_brows, brows[:NEUTRAL], atol=1e-12)
+
+
+@pytest.mark.render
+def test_chunks_of_frames_change_no_shift(rendered, monkeypatch):
+    from facelib.tracking import browimage
+    from facelib.tracking.observation import default_observation
+
+    _, landmarks, brows, frames = rendered
+    monkeypatch.setattr(browimage, "_CHUNK_FRAMES", 7)
+    again = browimage.track_brows(lambda: iter(frames), landmarks, neutral=(0, NEUTRAL),
+                                  model=default_observation())
+    np.testing.assert_allclose(again, brows, atol=1e-12)
+    with pytest.raises(browimage.TrackingError, match="more images than the 10"):
+        browimage.brow_features(frames[:12], landmarks[:10], _patches(landmarks, frames),
+                                _neutral(landmarks), default_observation())
+
+
+def _neutral(landmarks):
+    from facelib.tracking.headframe import neutral_face
+    from facelib.tracking.layouts import landmark_layout
+
+    return neutral_face(landmarks, layout=landmark_layout("mediapipe"), span=slice(0, NEUTRAL))
+
+
+def _patches(landmarks, frames):
+    from facelib.tracking.browimage import brow_patches
+    from facelib.tracking.observation import default_observation
+
+    return brow_patches(frames[:NEUTRAL], landmarks[:NEUTRAL], _neutral(landmarks),
+                        default_observation())
