@@ -85,14 +85,16 @@ class LiveFaps:
         """The neutral face, once its frames are in."""
         return self._neutral
 
-    def push(self, landmarks: np.ndarray | None, image: np.ndarray | None = None
-             ) -> np.ndarray | None:
+    def push(self, landmarks: np.ndarray | None, image: np.ndarray | None = None, *,
+             dt: float | None = None) -> np.ndarray | None:
         """The ``(84,) float64`` FAP values of the next frame from its ``(K, D)`` landmarks
         (image coordinates as for :func:`~facelib.tracking.faps.measure_faps`; None or
         NaN: no face): None while the neutral frames are being collected, the last values
         again for a frame without a face. With the frame's ``(H, W, 3) uint8`` RGB
         ``image`` (every frame's, the neutral ones' included), the brows are also read off
-        the image (:mod:`~facelib.tracking.browimage`), as for a video."""
+        the image (:mod:`~facelib.tracking.browimage`), as for a video. ``dt``: seconds
+        since the previous frame, for the filter (default ``1 / fps``; a camera's frames
+        come when they come)."""
         if landmarks is None or not np.isfinite(landmarks).all():
             return None if self._last is None else self._last.copy()
         frame = np.asarray(landmarks, np.float64)
@@ -115,7 +117,7 @@ class LiveFaps:
                                lips=lips, brows=brows)
         values = found.values[0]
         if self._smooth:
-            values = self._filter(values, found.mask[0])
+            values = self._filter(values, found.mask[0], 1.0 / self.fps if dt is None else dt)
         state = None
         if found.aperture is not None:
             closed = mouth_closed(found.aperture, closed=self._closed)
@@ -144,16 +146,17 @@ class LiveFaps:
                                                self._model)
         self._collected, self._images = [], []
 
-    def _filter(self, values: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    def _filter(self, values: np.ndarray, measured: np.ndarray, dt: float) -> np.ndarray:
         """``(84,)`` values through the causal One Euro filter over the ``(84,) bool``
-        ``measured`` columns (the same every frame), band by band."""
+        ``measured`` columns (the same every frame), band by band, ``dt`` seconds after the
+        last frame."""
         if self._bands is None:
             self._bands = filter_bands(measured)
             self._euro = [None] * len(self._bands)
         out = values.copy()
         for i, band in enumerate(self._bands):
             state = one_euro_step(values[band.cols] * band.scale, self._euro[i],
-                                  dt=1.0 / self.fps, min_cutoff=band.min_cutoff,
+                                  dt=dt, min_cutoff=band.min_cutoff,
                                   beta=band.beta, d_cutoff=band.d_cutoff)
             self._euro[i] = state
             out[band.cols] = state.value / band.scale
@@ -229,6 +232,7 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
     if not capture.isOpened():
         raise TrackingError(f"cannot open the camera or stream {source!r}")
     nominal = float(capture.get(cv2.CAP_PROP_FPS) or 0.0)
+    camera = isinstance(source, int) or str(source).startswith("/dev/")
     live = LiveFaps(fps=nominal if nominal > 0 else 30.0, neutral_frames=neutral_frames)
     record = _Recorder()
     try:
@@ -242,7 +246,8 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
                 image = np.ascontiguousarray(bgr[..., ::-1])
                 found = tracker.detect(image)
                 collecting = live.neutral is None
-                values = live.push(None if found is None else found.points, image)
+                values = live.push(None if found is None else found.points, image,
+                                   dt=_since(record.times) if camera else None)
                 record.add(None if found is None else found.points, values, live,
                            collecting=collecting)
                 if window and not avatar.show(bgr, values, live):
@@ -253,8 +258,12 @@ def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int =
         capture.release()
     if not record.points:
         raise TrackingError(f"no frame from {source!r}")
-    camera = isinstance(source, int) or str(source).startswith("/dev/")
     return record.finish(None if camera or nominal <= 0 else nominal)
+
+
+def _since(times: list[float]) -> float | None:
+    """Seconds between the last two frames read (None for the first)."""
+    return times[-1] - times[-2] if len(times) > 1 and times[-1] > times[-2] else None
 
 
 @dataclass

@@ -81,3 +81,19 @@ def test_bad_options_are_named():
     flat = camera(smooth_stream(2))[1, :, :2]
     with pytest.raises(ParameterError, match="observation model"):
         live.push(flat)
+
+
+def test_the_filter_follows_the_frames_real_intervals():
+    landmarks = camera(smooth_stream(60))
+    nominal = run(LiveFaps(fps=25, neutral_frames=NEUTRAL), landmarks)
+    live = LiveFaps(fps=25, neutral_frames=NEUTRAL)
+    same = np.stack([np.full(84, np.nan) if r is None else r
+                     for r in (live.push(f, dt=0.04) for f in landmarks)])
+    np.testing.assert_array_equal(same, nominal)
+    live = LiveFaps(fps=25, neutral_frames=NEUTRAL)  # a camera that delivers 5 frames/s
+    slow = np.stack([np.full(84, np.nan) if r is None else r
+                     for r in (live.push(f, dt=0.2) for f in landmarks)])
+    unfiltered = run(LiveFaps(fps=25, neutral_frames=NEUTRAL, smooth=False), landmarks)
+    # frames far apart are filtered less: closer to the unfiltered jaw
+    lag = np.abs(nominal[NEUTRAL:, 2] - unfiltered[NEUTRAL:, 2]).mean()
+    assert np.abs(slow[NEUTRAL:, 2] - unfiltered[NEUTRAL:, 2]).mean() < 0.5 * lag
