@@ -36,8 +36,8 @@ from facelib.tracking.headframe import (
     to_head_frame,
 )
 from facelib.tracking.layouts import landmark_layout
-from facelib.tracking.observation import ObservationModel, pose_correction
-from facelib.tracking.pose import HeadPose, euler_angles
+from facelib.tracking.observation import ObservationModel, head_angles
+from facelib.tracking.pose import HeadPose
 
 __all__ = ["N_FEATURES", "BrowPatches", "brow_features", "brow_patches", "sampling_poses",
            "track_brows"]
@@ -106,11 +106,8 @@ def sampling_poses(landmarks: np.ndarray, neutral: Neutral, model: ObservationMo
     again on the nose bridge and tip."""
     from facelib.engine.rigid import rotation_matrices
 
-    layout = landmark_layout("mediapipe")
-    frame = to_head_frame(landmarks, neutral, layout=layout)
-    assert frame.pose is not None
-    angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
-    angles += pose_correction(model, frame.motion, frame.fapu)
+    angles = head_angles(to_head_frame(landmarks, neutral, layout=landmark_layout("mediapipe")),
+                         model)
     rotation = rotation_matrices(angles[:, 0], angles[:, 1], angles[:, 2])
     nose = list(_settings().nose)
     turned = np.einsum("nij,sj->nsi", rotation, neutral.image_rest[nose])[..., :2]  # (n, s, 2)

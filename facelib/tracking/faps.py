@@ -54,10 +54,10 @@ from facelib.tracking.layouts import LandmarkLayout, landmark_layout
 from facelib.tracking.observation import (
     ObservationModel,
     default_observation,
-    pose_correction,
+    head_angles,
     solve_observation,
 )
-from facelib.tracking.pose import HEAD_FAP_IDS, HeadPose, euler_angles, join_poses
+from facelib.tracking.pose import HEAD_FAP_IDS, HeadPose, join_poses
 from facelib.tracking.relations import apply_relations
 from facelib.tracking.rigfit import RigModel, fit_faps, rig_model
 from facelib.tracking.smoothing import one_euro
@@ -299,10 +299,8 @@ def measure_frames(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkL
     :func:`measure_faps`'s ``rig``) and the frames' ``(n, 4)`` brow image shifts, if any."""
     frame = to_head_frame(landmarks, neutral, layout=layout)
     angles = None
-    if frame.pose is not None:
-        angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
-        if isinstance(model, ObservationModel):  # the fit's learned error taken out
-            angles += pose_correction(model, frame.motion, frame.fapu)
+    if frame.pose is not None:  # with the learned model, the fit's learned error taken out
+        angles = head_angles(frame, model if isinstance(model, ObservationModel) else None)
     values, mask = _face_faps(frame, layout, model, brows=brows, angles=angles)
     if angles is not None:
         values[:, [f - 1 for f in HEAD_FAP_IDS]] = angles / ANGLE_UNIT

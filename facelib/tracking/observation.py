@@ -44,13 +44,13 @@ from facelib.checks import check_count
 from facelib.data import path as data_path
 from facelib.errors import DataError, ParameterError, TrackingError
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, fap_table
-from facelib.tracking.headframe import head_frame, neutral_span
+from facelib.tracking.headframe import HeadFrame, head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.pose import HEAD_FAP_IDS, euler_angles
 
 __all__ = ["IMAGE_FAPS", "MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
-           "image_inputs", "learn_observation", "load_observation", "pose_correction",
-           "save_observation", "solve_observation"]
+           "head_angles", "image_inputs", "learn_observation", "load_observation",
+           "pose_correction", "save_observation", "solve_observation"]
 
 IMAGE_FAPS = (31, 32, 33, 34, 35, 36, 37, 38)
 """FAPs the packaged model also reads off the brows' image shifts: the brows' raise and
@@ -115,8 +115,18 @@ def _normalised(landmarks: np.ndarray, neutral: int | tuple[int, int]
     frame = head_frame(data, layout=layout, span=neutral_span(neutral, len(data)))
     if frame.pose is None:
         raise TrackingError("the observation model needs a rigid head fit")
+    return _over_es(frame.motion, frame.fapu), frame.fapu, head_angles(frame, None)
+
+
+def head_angles(frame: HeadFrame, model: ObservationModel | None) -> np.ndarray:
+    """``(n, 3)`` pitch, yaw and roll (radians) of ``frame``'s rigid fit (which must have
+    one), with ``model``'s learned error of the fit taken out (:func:`pose_correction`;
+    None: the fit alone)."""
+    assert frame.pose is not None
     angles = np.stack(euler_angles(frame.pose.rotation), axis=1)
-    return _over_es(frame.motion, frame.fapu), frame.fapu, angles
+    if model is not None:
+        angles += pose_correction(model, frame.motion, frame.fapu)
+    return angles
 
 
 def _over_es(displacements: np.ndarray, fapu: Mapping[str, float]) -> np.ndarray:
