@@ -187,21 +187,23 @@ _QUIT_KEYS = (ord("q"), 27)
 _HOLD_STILL = "hold a neutral face"
 
 
-def _mirror_image(image: np.ndarray, avatar: np.ndarray | None, *, collecting: bool
+def _mirror_image(camera: np.ndarray, avatar: np.ndarray | None, *, collecting: bool
                   ) -> np.ndarray:
-    """The window's ``(H, W1 + W2, 3) uint8`` BGR image from the ``(H, W1, 3)`` RGB camera
-    image and the ``(H, W2, 3)`` RGB avatar beside it (grey while there is none), neither
-    flipped, as in the recorded mirror (:mod:`~facelib.tracking.mirror`)."""
+    """The window's BGR image: the ``(H, W1, 3)`` BGR camera image and the ``(H, W2, 3)``
+    RGB avatar (grey while there is none) joined as the recorded mirror joins them
+    (:func:`~facelib.tracking.mirror.mirror_frames`, neither flipped)."""
     import cv2
 
-    height = image.shape[0]
-    left = np.ascontiguousarray(image[..., ::-1])
+    from facelib.tracking.mirror import mirror_frames
+
+    height = camera.shape[0]
     right = (np.full((height, height * 4 // 3, 3), 40, np.uint8) if avatar is None
-             else np.ascontiguousarray(avatar[..., ::-1]))
+             else avatar[..., ::-1])
+    image = next(mirror_frames(iter([camera]), iter([right])))
     if collecting:
-        cv2.putText(left, _HOLD_STILL, (16, 36), cv2.FONT_HERSHEY_SIMPLEX, 1.0,
+        cv2.putText(image, _HOLD_STILL, (16, 36), cv2.FONT_HERSHEY_SIMPLEX, 1.0,
                     (60, 220, 60), 2, cv2.LINE_AA)
-    return np.concatenate([left, right[:height]], axis=1)
+    return image
 
 
 def run_camera(source: int | str = 0, *, face: Any = None, neutral_frames: int = 25,
@@ -337,7 +339,7 @@ class _Avatar:
             vertices = self._face.deform(FapStream(live.fps, values[None], live.mask[None]))
             image = self._renderer.frame(np.asarray(vertices[0], np.float32))
         scale = 360 / bgr.shape[0]
-        small = cv2.resize(bgr, (round(bgr.shape[1] * scale), 360))[..., ::-1]
+        small = cv2.resize(bgr, (round(bgr.shape[1] * scale), 360))
         cv2.imshow("facelib mirror", _mirror_image(small, image, collecting=values is None))
         key = cv2.waitKey(1) & 0xFF
         closed = cv2.getWindowProperty("facelib mirror", cv2.WND_PROP_VISIBLE) < 1
