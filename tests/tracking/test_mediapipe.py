@@ -54,3 +54,16 @@ def test_no_face_and_bad_images():
     with pytest.raises(ParameterError, match="shape"):
         detect_landmarks(blank[..., 0])
 
+
+
+def test_the_graph_starting_keeps_stderr_clean(default_head_render, capfd, caplog):
+    """What MediaPipe's C++ side prints as its graph starts (TensorFlow Lite's delegate
+    notice, absl warnings) goes to facelib's log, not to the process's stderr."""
+    image, _ = default_head_render
+    capfd.readouterr()
+    with caplog.at_level("INFO", logger="facelib.tracking"), \
+            FaceMeshTracker(video=True, max_faces=1) as tracker:
+        assert tracker.detect(image) is not None
+        assert tracker.detect(image) is not None
+    assert capfd.readouterr().err == ""
+    assert all(r.getMessage().startswith("mediapipe: ") for r in caplog.records)
