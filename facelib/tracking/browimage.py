@@ -108,7 +108,8 @@ def sampling_poses(landmarks: np.ndarray, neutral: Neutral, model: ObservationMo
 
     angles = head_angles(to_head_frame(landmarks, neutral, layout=landmark_layout("mediapipe")),
                          model)
-    rotation = rotation_matrices(angles[:, 0], angles[:, 1], angles[:, 2])
+    level = neutral.level  # the angles are about the neutral head's axes, levelled
+    rotation = level.T @ rotation_matrices(angles[:, 0], angles[:, 1], angles[:, 2]) @ level
     nose = list(_settings().nose)
     turned = np.einsum("nij,sj->nsi", rotation, neutral.image_rest[nose])[..., :2]  # (n, s, 2)
     seen = np.asarray(landmarks, np.float64)[:, nose, :2] * [1.0, -1.0]  # face frame x, y
@@ -132,7 +133,7 @@ def _grids(neutral: Neutral) -> tuple[np.ndarray, np.ndarray]:
 
     cfg = _settings()
     es = neutral.fapu["ES"] * FAPU_SCALE
-    rest = neutral.image_rest
+    rest = neutral.image_rest @ neutral.level.T  # laid out upright, then turned back
     depth = LinearNDInterpolator(rest[:468, :2], rest[:468, 2])
     step = cfg.step * es
     tops = [rest[upper, 1] + cfg.above * es for upper, _ in cfg.brows]
@@ -152,7 +153,7 @@ def _grids(neutral: Neutral) -> tuple[np.ndarray, np.ndarray]:
             out.append(np.stack([gx, gy, depth(gx, gy)], axis=-1))
     if not np.isfinite(np.concatenate([r.ravel() for r in regions])).all():
         raise TrackingError("the brow patches reach beyond the neutral face's landmarks")
-    return np.stack(patches), np.stack(regions)
+    return np.stack(patches) @ neutral.level, np.stack(regions) @ neutral.level
 
 
 def _sample(grey: np.ndarray, points: np.ndarray, pose: HeadPose, i: int) -> np.ndarray:

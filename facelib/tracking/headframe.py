@@ -4,6 +4,11 @@ Image coordinates are turned into the face frame (``x`` to the face's left = the
 right in a non-mirrored camera, ``y`` up, ``z`` toward the camera), frames without a face
 are interpolated, the rigid head pose is fitted on the layout's stable points and undone,
 and the user's FAPU are measured on the neutral frames (eq. 4.12-4.15).
+
+The neutral head's frame is upright: a neutral face tilted in the image (a tilted head, a
+camera on its side) is turned about the camera's axis until its eye centres are level, so
+the FAPs' axes are the face's own whatever the tilt; the head pose keeps the neutral as its
+rest, its pitch and yaw about the face's axes.
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ import numpy as np
 from facelib.errors import ParameterError, TrackingError
 from facelib.tracking.layouts import LandmarkLayout
 from facelib.tracking.pose import HeadPose, fit_pose, refine_pose_2d, unpose, unpose_2d
-from facelib.tracking.userfapu import user_fapu
+from facelib.tracking.userfapu import complete_points, user_fapu
 
 __all__ = ["HeadFrame", "Neutral", "face_frame", "fill_gaps", "frame_spans", "head_frame",
            "neutral_face", "neutral_span", "to_head_frame"]
@@ -34,7 +39,8 @@ class HeadFrame:
     points: ``(n, P, D)`` the layout's feature points, same frame.
     rest_points: ``(P, D)`` their neutral mean.
     fapu: the user's FAPU in the landmarks' unit per FAP unit (``AU`` in radians).
-    pose: the per-frame head fit (None when only translation was corrected).
+    pose: the per-frame head fit, its axes the neutral head's (None when only translation
+        was corrected).
     """
 
     landmarks: np.ndarray
@@ -114,12 +120,40 @@ class Neutral:
     rest: ``(K, D) float64`` their mean in the neutral head's frame.
     rest_points: ``(P, D) float64`` the layout's feature points there.
     fapu: the user's FAPU in the landmarks' unit per FAP unit (``AU`` in radians).
+    level: ``(D, D) float64`` the rotation about the camera's axis that turns the face frame
+        into the neutral head's (eye centres level; identity when the layout has none).
     """
 
     image_rest: np.ndarray
     rest: np.ndarray
     rest_points: np.ndarray
     fapu: dict[str, float]
+    level: np.ndarray
+
+
+def _levelling(image_rest: np.ndarray, layout: LandmarkLayout) -> np.ndarray:
+    """``(D, D)`` the rotation about the camera's axis that levels the eyes of the ``(K, D)``
+    neutral ``image_rest``: the midpoints of their corners (3.7/3.11, 3.8/3.12), which do not
+    move with the gaze as the pupils do, else the eye centres 3.5/3.6 or their eq.
+    4.12/4.13 fill-ins; the identity for a layout with neither."""
+    level = np.eye(image_rest.shape[1])
+    points = complete_points(dict(zip(layout.feature_points,
+                                      layout.feature_point_positions(image_rest[None])[0],
+                                      strict=True)))
+    for left, right in ((("3.7", "3.11"), ("3.8", "3.12")), (("3.5",), ("3.6",))):
+        if all(fp in points for fp in left + right):
+            across = (np.mean([points[fp][:2] for fp in left], axis=0)
+                      - np.mean([points[fp][:2] for fp in right], axis=0))
+            tilt = np.arctan2(across[1], across[0])  # the face's right eye to its left
+            level[:2, :2] = [[np.cos(tilt), np.sin(tilt)], [-np.sin(tilt), np.cos(tilt)]]
+            break
+    return level
+
+
+def _levelled(pose: HeadPose, level: np.ndarray) -> HeadPose:
+    """``pose`` (the fit in the face frame) with its axes the neutral head's: rotations
+    ``L R L^T``, translations ``L t``."""
+    return HeadPose(pose.scale, level @ pose.rotation @ level.T, pose.translation @ level.T)
 
 
 def _remove_pose(points: np.ndarray, layout: LandmarkLayout, image_rest: np.ndarray
@@ -149,10 +183,11 @@ def neutral_face(landmarks: np.ndarray, *, layout: LandmarkLayout, span: slice,
     (:func:`fill_gaps`), from the neutral frames ``span``, with FAPU overrides ``fapu``."""
     points = face_frame(landmarks[span])
     image_rest = points.mean(axis=0)
-    rest = _remove_pose(points, layout, image_rest)[0].mean(axis=0)
+    level = _levelling(image_rest, layout)
+    rest = _remove_pose(points, layout, image_rest)[0].mean(axis=0) @ level.T
     rest_points = layout.feature_point_positions(rest[None])[0]
     units = user_fapu(dict(zip(layout.feature_points, rest_points, strict=True)), fapu)
-    return Neutral(image_rest, rest, rest_points, units)
+    return Neutral(image_rest, rest, rest_points, units, level)
 
 
 def to_head_frame(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkLayout
@@ -160,8 +195,10 @@ def to_head_frame(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkLa
     """``(n, K, D)`` image-coordinate landmarks without gaps in the head frame of
     ``neutral`` (any frames of the track it was taken from, e.g. a chunk of a long one)."""
     local, pose = _remove_pose(face_frame(landmarks), layout, neutral.image_rest)
+    local = local @ neutral.level.T
     return HeadFrame(local, neutral.rest, layout.feature_point_positions(local),
-                     neutral.rest_points, neutral.fapu, pose)
+                     neutral.rest_points, neutral.fapu,
+                     None if pose is None else _levelled(pose, neutral.level))
 
 
 def head_frame(landmarks: np.ndarray, *, layout: LandmarkLayout, span: slice,

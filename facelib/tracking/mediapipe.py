@@ -60,10 +60,10 @@ def _face_mesh_module() -> Any:
 @contextmanager
 def _native_stderr_logged() -> Iterator[None]:
     """Send what C++ code writes to the process's stderr meanwhile (MediaPipe's graph, as it
-    starts, prints TensorFlow Lite's delegate notice and absl warnings about itself) to
-    this module's log at INFO instead: a pipeline's stderr keeps facelib's own messages, and
-    ``facelib -v`` still shows them. Anything the process writes to stderr in the meantime,
-    from any thread, goes the same way."""
+    starts and as it first sees a face, prints TensorFlow Lite's delegate notice and absl
+    warnings about itself) to this module's log at INFO instead: a pipeline's stderr keeps
+    facelib's own messages, and ``facelib -v`` still shows them. Anything the process
+    writes to stderr in the meantime, from any thread, goes the same way."""
     sys.stderr.flush()
     saved = os.dup(2)
     with tempfile.TemporaryFile() as sink:
@@ -109,11 +109,14 @@ class FaceMeshTracker:
         detect = check_number("min_detection_confidence", min_detection_confidence,
                               low=0, high=1)
         track = check_number("min_tracking_confidence", min_tracking_confidence, low=0, high=1)
-        self._mesh: Any = _face_mesh_module().FaceMesh(
-            static_image_mode=not video, max_num_faces=int(max_faces), refine_landmarks=True,
-            min_detection_confidence=detect, min_tracking_confidence=track,
-        )
-        self._started = False
+        module = _face_mesh_module()
+        with _native_stderr_logged():  # the graph starts in threads of its own
+            self._mesh: Any = module.FaceMesh(
+                static_image_mode=not video, max_num_faces=int(max_faces),
+                refine_landmarks=True, min_detection_confidence=detect,
+                min_tracking_confidence=track)
+            self._mesh.process(np.zeros((64, 64, 3), np.uint8))  # returns once it runs
+        self._seen_face = False
 
     def detect(self, image: np.ndarray) -> FaceLandmarks | None:
         """Landmarks of the largest face in ``image`` (``(H, W, 3) uint8`` RGB), or None if
@@ -122,15 +125,15 @@ class FaceMeshTracker:
             raise TrackingError("this FaceMeshTracker is closed")
         rgb = _check_image(image)
         height, width = rgb.shape[:2]
-        if self._started:
+        if self._seen_face:
             result = self._mesh.process(rgb)
-        else:  # the graph starts on the first image
+        else:  # the landmark stages warn as they first see a face
             with _native_stderr_logged():
                 result = self._mesh.process(rgb)
-            self._started = True
         faces = result.multi_face_landmarks or []
         if not faces:
             return None
+        self._seen_face = True
         best: tuple[float, np.ndarray, np.ndarray] | None = None
         for face in faces:
             pts = np.array([(p.x * width, p.y * height, p.z * width) for p in face.landmark],

