@@ -8,6 +8,7 @@ are named too.
 
 from __future__ import annotations
 
+import logging
 import os
 import subprocess
 import warnings
@@ -26,6 +27,8 @@ from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
 from facelib.tracking.headframe import neutral_span
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.observation import ObservationModel, default_observation
+
+log = logging.getLogger("facelib.tracking")
 
 __all__ = ["VideoInfo", "VideoTrack", "extract_audio", "read_video", "track_video",
            "track_video_faps", "video_brows"]
@@ -73,6 +76,13 @@ def _imageio_ffmpeg() -> Any:
     return imageio_ffmpeg
 
 
+def _not_turned(record: logging.LogRecord) -> bool:
+    """imageio-ffmpeg's log, less its warning that the frames read are not the size
+    stored: ffmpeg turns the frames of a video that says it is rotated (a phone held
+    upright), as it should; :func:`read_video` says so at INFO."""
+    return "different from the source frame size" not in record.getMessage()
+
+
 def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.ndarray]]:
     """The video's :class:`VideoInfo` and an iterator of ``(H, W, 3) uint8`` RGB frames.
 
@@ -82,12 +92,19 @@ def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.nda
     if not path.is_file():
         raise TrackingError(f"video {str(path)!r} does not exist")
     reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24")
+    ffmpeg_log = logging.getLogger("imageio_ffmpeg")
+    ffmpeg_log.addFilter(_not_turned)
     try:
         meta = next(reader)
     except (OSError, RuntimeError, StopIteration) as exc:
         reader.close()
         raise TrackingError(f"ffmpeg cannot read a video stream from it ({exc})".splitlines()[0],
                             path=path) from exc
+    finally:
+        ffmpeg_log.removeFilter(_not_turned)
+    if tuple(meta.get("source_size", meta["size"])) != tuple(meta["size"]):
+        log.info("%s: stored %s, read %s: ffmpeg turns the frames as the file says", path,
+                 "x".join(map(str, meta["source_size"])), "x".join(map(str, meta["size"])))
     fps = float(meta.get("fps") or 0)
     width, height = (int(v) for v in meta["size"])
     if not fps > 0:

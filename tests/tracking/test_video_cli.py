@@ -148,3 +148,25 @@ def test_camera_mode_refuses_before_it_records(face_video, tmp_path, capsys, mon
     assert "a face in 16 of 16 frames, fewer than the 20 neutral frames" in (
         capsys.readouterr().err)
     assert not (tmp_path / "x.fap").exists()
+
+
+def test_a_video_stored_on_its_side_is_tracked_as_shown(face_video, tmp_path, capfd):
+    """A video whose display matrix turns it (a phone held upright) is read turned, as
+    players show it, without imageio-ffmpeg's warning about the size; the face then lies on
+    its side in the frames, and the levelled neutral measures it as upright."""
+    import subprocess
+
+    import imageio_ffmpeg
+
+    turned = tmp_path / "turned.mp4"
+    subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "error", "-display_rotation", "90",
+                    "-i", str(face_video), "-c", "copy", str(turned)], check=True)
+    for video, name in ((face_video, "upright.fap"), (turned, "turned.fap")):
+        assert main(["track", str(video), "-o", str(tmp_path / name), "--neutral", "0:4",
+                     "-q"]) == 0
+    err = capfd.readouterr().err
+    assert "frame size" not in err and "W0000" not in err, err
+    upright, sideways = (read_fap(tmp_path / n).values for n in ("upright.fap", "turned.fap"))
+    jaw = np.clip(np.arange(N) - 4, 0, None)
+    assert np.corrcoef(sideways[:, 2], jaw)[0, 1] > 0.8
+    assert np.abs(sideways[:, 2] - upright[:, 2]).max() < 0.05 * upright[:, 2].max()
