@@ -36,7 +36,8 @@ __all__ = ["VideoInfo", "VideoTrack", "extract_audio", "read_video", "track_vide
 
 @dataclass(frozen=True)
 class VideoInfo:
-    """A video's frame rate, frame size in pixels and whether it has sound."""
+    """A video's frame rate as :func:`read_video` reads it (whole frames a second), frame
+    size in pixels as shown (turned as the file says) and whether it has sound."""
 
     fps: float
     width: int
@@ -83,33 +84,49 @@ def _not_turned(record: logging.LogRecord) -> bool:
     return "different from the source frame size" not in record.getMessage()
 
 
-def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.ndarray]]:
-    """The video's :class:`VideoInfo` and an iterator of ``(H, W, 3) uint8`` RGB frames.
-
-    TrackingError if the file is missing or ffmpeg finds no video stream in it.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise TrackingError(f"video {str(path)!r} does not exist")
-    reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24")
+def _start(path: Path, rate: float | None = None) -> tuple[Any, dict[str, Any]]:
+    """ffmpeg decoding ``path`` to RGB, at ``rate`` frames a second (None: as it comes), and
+    the metadata it reports; TrackingError when it finds no video stream."""
+    options = None if rate is None else ["-vf", f"fps={rate!r}"]
+    reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24", output_params=options)
     ffmpeg_log = logging.getLogger("imageio_ffmpeg")
     ffmpeg_log.addFilter(_not_turned)
     try:
-        meta = next(reader)
+        return reader, next(reader)
     except (OSError, RuntimeError, StopIteration) as exc:
         reader.close()
         raise TrackingError(f"ffmpeg cannot read a video stream from it ({exc})".splitlines()[0],
                             path=path) from exc
     finally:
         ffmpeg_log.removeFilter(_not_turned)
+
+
+def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.ndarray]]:
+    """The video's :class:`VideoInfo` and an iterator of ``(H, W, 3) uint8`` RGB frames.
+
+    The frames come evenly spaced in time at the whole rate nearest the video's average (a
+    .fap holds whole rates: 30 for NTSC's 29.97): ffmpeg repeats or drops frames by their
+    timestamps, which also evens out a variable-rate video (as phones record), so frame
+    ``i`` shows time ``i / fps``. TrackingError if the file is missing or ffmpeg finds no
+    video stream in it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise TrackingError(f"video {str(path)!r} does not exist")
+    probe, meta = _start(path)
+    probe.close()
+    average = float(meta.get("fps") or 0)
+    if not average > 0:
+        raise TrackingError("the video has no frame rate", path=path)
+    fps = float(max(1, round(average)))
+    if fps != average:
+        log.info("%s: read at %g frames a second (the video's average is %g)", path, fps,
+                 average)
     if tuple(meta.get("source_size", meta["size"])) != tuple(meta["size"]):
         log.info("%s: stored %s, read %s: ffmpeg turns the frames as the file says", path,
                  "x".join(map(str, meta["source_size"])), "x".join(map(str, meta["size"])))
-    fps = float(meta.get("fps") or 0)
+    reader = _start(path, fps)[0]
     width, height = (int(v) for v in meta["size"])
-    if not fps > 0:
-        reader.close()
-        raise TrackingError("the video has no frame rate", path=path)
     info = VideoInfo(fps, width, height, bool(meta.get("audio_codec")))
 
     def frames() -> Iterator[np.ndarray]:

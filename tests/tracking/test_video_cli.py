@@ -170,3 +170,27 @@ def test_a_video_stored_on_its_side_is_tracked_as_shown(face_video, tmp_path, ca
     jaw = np.clip(np.arange(N) - 4, 0, None)
     assert np.corrcoef(sideways[:, 2], jaw)[0, 1] > 0.8
     assert np.abs(sideways[:, 2] - upright[:, 2]).max() < 0.05 * upright[:, 2].max()
+
+
+def test_a_variable_rate_video_keeps_its_timing(face_video, tmp_path):
+    """A video whose first half runs at 12.5 frames a second and second at 25 (as phones
+    record): the .fap lasts as long as the video and the jaw opens when it does."""
+    import subprocess
+
+    import imageio_ffmpeg
+
+    uneven = tmp_path / "uneven.mp4"
+    times = "if(lt(N,8),N*2,8+N)/25/TB"  # frames 0-7 0.08 s apart, then 0.04 s
+    subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "error", "-i", str(face_video),
+                    "-vf", f"setpts='{times}'", "-fps_mode", "vfr", "-an", str(uneven)],
+                   check=True)
+    assert main(["track", str(uneven), "-o", str(tmp_path / "out.fap"), "--neutral", "0:2",
+                 "-q"]) == 0
+    stream = read_fap(tmp_path / "out.fap")
+    shown = np.where(np.arange(N) < 8, np.arange(N) * 0.08, 0.32 + np.arange(N) * 0.04)
+    assert abs(stream.n_frames / stream.fps - (shown[-1] + 0.04)) < 1.5 / stream.fps
+    truth = np.clip(np.arange(N) - 4, 0, None) * 40.0
+    half = np.interp(truth.max() / 2, truth[4:], shown[4:])  # when the true jaw is half open
+    jaw = stream.values[:, 2].astype(float)
+    found = np.interp(jaw.max() / 2, np.maximum.accumulate(jaw), np.arange(len(jaw)) / stream.fps)
+    assert abs(found - half) < 1.5 / stream.fps
