@@ -194,3 +194,22 @@ def test_a_variable_rate_video_keeps_its_timing(face_video, tmp_path):
     jaw = stream.values[:, 2].astype(float)
     found = np.interp(jaw.max() / 2, np.maximum.accumulate(jaw), np.arange(len(jaw)) / stream.fps)
     assert abs(found - half) < 1.5 / stream.fps
+
+
+def test_landmarks_at_a_rate_that_is_not_whole(face_video, tmp_path, capsys):
+    """Landmarks at 29.97 frames a second (a camera's or another tracker's rate) give a .fap
+    at 30, as long and with the same jaw: a .fap holds whole rates."""
+    from facelib.tracking.files import write_landmarks_csv
+
+    assert main(["track", str(face_video), "-o", str(tmp_path / "at25.fap"), "--neutral", "0:4",
+                 "--landmarks-out", str(tmp_path / "l.csv")]) == 0
+    marks = read_landmarks(tmp_path / "l.csv").landmarks
+    write_landmarks_csv(tmp_path / "ntsc.csv", marks, fps=29.97)
+    capsys.readouterr()
+    assert main(["track", str(tmp_path / "ntsc.csv"), "-o", str(tmp_path / "ntsc.fap"),
+                 "--neutral", "0:4"]) == 0
+    assert "resampled from 29.97 to 30" in capsys.readouterr().err
+    stream = read_fap(tmp_path / "ntsc.fap")
+    assert stream.fps == 30 and abs(stream.duration - N / 29.97) < 1 / 30
+    jaw = read_fap(tmp_path / "at25.fap").values[:, 2].astype(float)
+    assert abs(stream.values[:, 2].max() - jaw.max()) < 0.05 * jaw.max()
