@@ -6,7 +6,7 @@ are interpolated, the rigid head pose is fitted on the layout's stable points an
 and the user's FAPU are measured on the neutral frames (eq. 4.12-4.15).
 
 The neutral head's frame is upright: a neutral face tilted in the image (a tilted head, a
-camera on its side) is turned about the camera's axis until its eye centres are level, so
+camera on its side) is turned about the camera's axis until its eyes are level, so
 the FAPs' axes are the face's own whatever the tilt; the head pose keeps the neutral as its
 rest, its pitch and yaw about the face's axes.
 """
@@ -121,7 +121,7 @@ class Neutral:
     rest_points: ``(P, D) float64`` the layout's feature points there.
     fapu: the user's FAPU in the landmarks' unit per FAP unit (``AU`` in radians).
     level: ``(D, D) float64`` the rotation about the camera's axis that turns the face frame
-        into the neutral head's (eye centres level; identity when the layout has none).
+        into the neutral head's (eyes level; identity when the layout has no eyes).
     """
 
     image_rest: np.ndarray
