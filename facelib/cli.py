@@ -561,6 +561,11 @@ def _evaluate(args: argparse.Namespace, console: Console) -> int:
 # -- track -------------------------------------------------------------------------------
 
 
+def _neutral(args: argparse.Namespace) -> tuple[int, int] | None:
+    """``facelib track``'s ``--neutral``; None: the first frame with a face."""
+    return None if args.neutral is None else _span(args.neutral)
+
+
 def _span(text: str) -> tuple[int, int]:
     """``"N"`` -> (N, N + 1); ``"A:B"`` -> (A, B)."""
     try:
@@ -592,7 +597,8 @@ def _add_track(commands: Any) -> None:
     track.add_argument("--face", help="the avatar's face definition (default: bundled head)")
     track.add_argument("--show-landmarks", action="store_true",
                        help="draw the tracked landmarks on the mirror's source side")
-    track.add_argument("--neutral", default="0", help="neutral frame N or span START:STOP")
+    track.add_argument("--neutral", help="neutral frame N or span START:STOP (default: the "
+                       "first frame with a face)")
     track.add_argument("--pucker", action="append", metavar="START:STOP",
                        help="frames labelled pucker (eq. 4.17 high-level state); repeatable")
     track.add_argument("--no-smooth", action="store_true", help="skip the One Euro filter")
@@ -614,13 +620,13 @@ def _is_landmark_file(source: Path) -> bool:
 @dataclass(frozen=True)
 class _Tracked:
     """What ``facelib track`` measures: ``(n, K, D)`` landmarks at ``fps`` in ``layout``,
-    the ``neutral`` span, the ``video`` (None for files and cameras) and the brows'
-    ``(n, 4)`` image shifts (None for landmark files)."""
+    the ``neutral`` span (None: the first frame with a face), the ``video`` (None for files
+    and cameras) and the brows' ``(n, 4)`` image shifts (None for landmark files)."""
 
     landmarks: Any
     fps: float
     layout: str
-    neutral: tuple[int, int]
+    neutral: tuple[int, int] | None
     video: Path | None = None
     brows: Any = None
 
@@ -638,14 +644,20 @@ def _track_source(args: argparse.Namespace, console: Console) -> _Tracked:
         layout = args.layout or file.layout
         if fps is None or layout is None:
             raise FacelibError(f"{source}: give --fps and --layout (the file does not say)")
-        return _Tracked(file.landmarks, fps, layout, _span(args.neutral))
+        return _Tracked(file.landmarks, fps, layout, _neutral(args))
     from facelib.tracking.video import track_video, video_brows
 
     track = track_video(source, max_frames=args.max_frames)
     console.status(f"tracked {len(track.landmarks)} frames of {source} ({track.info.width}x"
                    f"{track.info.height}, {track.info.fps:g} fps); no face in "
                    f"{len(track.lost_frames)}")
-    neutral = _span(args.neutral)
+    neutral = _neutral(args)
+    if neutral is None:
+        first = track.first_lit_face
+        neutral = (first, first + 1)
+        if first:
+            console.status(f"neutral: frame {first}, the first with a well-lit face "
+                           "(--neutral chooses another)")
     return _Tracked(track.landmarks, track.info.fps, "mediapipe", neutral, source,
                     video_brows(source, track.landmarks, neutral=neutral))
 

@@ -32,6 +32,7 @@ from facelib.tracking.headframe import (
     Neutral,
     fill_gaps,
     neutral_face,
+    neutral_frames,
     neutral_span,
     to_head_frame,
 )
@@ -246,15 +247,18 @@ def _register(grey: np.ndarray, patches: BrowPatches, pose: HeadPose, i: int) ->
 
 
 def track_brows(open_frames: Callable[[], Iterable[np.ndarray]], landmarks: np.ndarray, *,
-                neutral: tuple[int, int], model: ObservationModel) -> np.ndarray:
+                neutral: int | tuple[int, int] | None, model: ObservationModel) -> np.ndarray:
     """``(n, 4)`` :func:`brow_features` of a track: ``open_frames()`` gives its ``(H, W, 3)
     uint8`` RGB frames from the first, each time it is called (it is called twice: once up
-    to the end of the ``neutral`` frames ``(start, stop)``, once for all);
-    ``(n, 478, 3)`` MediaPipe ``landmarks`` (NaN rows: no face) and ``model`` as for
-    :func:`~facelib.tracking.faps.measure_faps`."""
-    filled = fill_gaps(landmarks)[0]
-    span = neutral_span(neutral, len(filled))
-    rest = neutral_face(filled, layout=landmark_layout("mediapipe"), span=span)
-    start, stop = span.start, span.stop
-    patches = brow_patches(islice(open_frames(), start, stop), filled[start:stop], rest, model)
+    to the end of the ``neutral`` frames, once for all); ``(n, 478, 3)`` MediaPipe
+    ``landmarks`` (NaN rows: no face), ``neutral`` and ``model`` as for
+    :func:`~facelib.tracking.faps.measure_faps` (the templates come from the neutral frames
+    with a face)."""
+    filled, lost = fill_gaps(landmarks)
+    span = neutral_span(neutral, len(filled), lost=lost)
+    rest = neutral_face(filled, layout=landmark_layout("mediapipe"), span=span, lost=lost)
+    frames = neutral_frames(span, lost)
+    keep = set(frames.tolist())
+    images = (image for i, image in enumerate(islice(open_frames(), span.stop)) if i in keep)
+    patches = brow_patches(images, filled[frames], rest, model)
     return brow_features(open_frames(), landmarks, patches, rest, model)

@@ -381,7 +381,7 @@ def measure_faps(
     *,
     fps: float,
     layout: str | LandmarkLayout = "mediapipe",
-    neutral: int | tuple[int, int] = 0,
+    neutral: int | tuple[int, int] | None = None,
     fapu: Mapping[str, float] | None = None,
     smooth: bool = True,
     states: Mapping[str, np.ndarray] | None = None,
@@ -399,7 +399,8 @@ def measure_faps(
     fps: the frames' rate.
     layout: a packaged layout name (``"mediapipe"``, ``"ibug68"``) or a
         :class:`~facelib.tracking.layouts.LandmarkLayout`.
-    neutral: the neutral frame, or a ``(start, stop)`` span averaged.
+    neutral: the neutral frame, or a ``(start, stop)`` span averaged over its frames with a
+        face; None: the first frame with a face. TrackingError when it has none.
     fapu: FAPU overrides in the landmarks' unit (e.g. ``{"MNS": 18.3 / 1024}``).
     smooth: apply the One Euro filter.
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
@@ -422,11 +423,8 @@ def measure_faps(
     rate = check_fps(fps)
     data, layout, model = checked_inputs(landmarks, layout, rig)
     data, filled = fill_gaps(data)
-    if filled:
-        warnings.warn(TrackingWarning(f"no face in frames {frame_spans(np.array(filled))} of "
-                                      f"{len(data)}; interpolated"), stacklevel=2)
+    rest = _neutral(data, filled, neutral, layout=layout, fapu=fapu)
     shifts = _brow_shifts(brows, model, len(data))
-    rest = neutral_face(data, layout=layout, span=neutral_span(neutral, len(data)), fapu=fapu)
     lips = close_lips and model is not None and layout.name == "mediapipe"
     found = _join([measure_frames(data[cut], rest, layout=layout, model=model, lips=lips,
                                   brows=None if shifts is None else shifts[cut])
@@ -436,6 +434,20 @@ def measure_faps(
         states=states, relations=relations,
         lips=None if found.aperture is None else (found.aperture, mouth_closed(found.aperture)))
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
+
+
+def _neutral(data: np.ndarray, filled: tuple[int, ...], neutral: int | tuple[int, int] | None,
+             *, layout: LandmarkLayout, fapu: Mapping[str, float] | None) -> Neutral:
+    """:func:`measure_faps`'s neutral face of the gap-filled ``data`` (its ``filled``
+    frames had no face), after a TrackingWarning naming those frames (and the neutral frame
+    chosen, when ``neutral`` is None)."""
+    span = neutral_span(neutral, len(data), lost=filled)
+    if filled:
+        news = f"no face in frames {frame_spans(np.array(filled))} of {len(data)}; interpolated"
+        if neutral is None and span.start:
+            news += f"; the neutral is frame {span.start}, the first with a face"
+        warnings.warn(TrackingWarning(news), stacklevel=3)
+    return neutral_face(data, layout=layout, span=span, fapu=fapu, lost=filled)
 
 
 def landmarks_to_faps(landmarks: np.ndarray, *, fps: float, **options: object) -> FapStream:

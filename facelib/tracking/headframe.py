@@ -13,7 +13,7 @@ rest, its pitch and yaw about the face's axes.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +24,7 @@ from facelib.tracking.pose import HeadPose, fit_pose, refine_pose_2d, unpose, un
 from facelib.tracking.userfapu import complete_points, user_fapu
 
 __all__ = ["HeadFrame", "Neutral", "face_frame", "fill_gaps", "frame_spans", "head_frame",
-           "neutral_face", "neutral_span", "to_head_frame"]
+           "neutral_face", "neutral_frames", "neutral_span", "to_head_frame"]
 
 
 @dataclass(frozen=True)
@@ -99,13 +99,31 @@ def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
     return data, tuple(int(i) for i in np.flatnonzero(lost))
 
 
-def neutral_span(neutral: int | tuple[int, int], n: int) -> slice:
-    """The neutral frame or ``(start, stop)`` span as a slice; ParameterError outside
-    ``n`` frames."""
+def neutral_span(neutral: int | tuple[int, int] | None, n: int, *,
+                 lost: Collection[int] = ()) -> slice:
+    """The neutral frame or ``(start, stop)`` span as a slice, None: the first of ``n``
+    frames with a face (not in ``lost``). ParameterError for an empty span or one outside
+    the ``n`` frames."""
+    if neutral is None:
+        first = next((i for i in range(n) if i not in set(lost)), 0)
+        return slice(first, first + 1)
     start, stop = (neutral, neutral + 1) if isinstance(neutral, int) else neutral
+    if start >= stop:
+        raise ParameterError(f"neutral frames {neutral!r} are an empty span")
     if not 0 <= start < stop <= n:
         raise ParameterError(f"neutral frames {neutral!r} are outside the {n} frames")
     return slice(start, stop)
+
+
+def neutral_frames(span: slice, lost: Collection[int]) -> np.ndarray:
+    """``(k,) int64`` the frames of the neutral ``span`` with a face (not in ``lost``);
+    TrackingError naming the span when there are none."""
+    frames = np.setdiff1d(np.arange(span.start, span.stop), np.asarray(list(lost), np.int64))
+    if not frames.size:
+        raise TrackingError("no face in the neutral frames "
+                            f"{frame_spans(np.arange(span.start, span.stop))}: choose frames "
+                            "where the face is seen, still and relaxed")
+    return frames
 
 
 @dataclass(frozen=True)
@@ -178,10 +196,13 @@ def _remove_pose(points: np.ndarray, layout: LandmarkLayout, image_rest: np.ndar
 
 
 def neutral_face(landmarks: np.ndarray, *, layout: LandmarkLayout, span: slice,
-                 fapu: Mapping[str, float] | None = None) -> Neutral:
+                 fapu: Mapping[str, float] | None = None, lost: Collection[int] = ()
+                 ) -> Neutral:
     """The :class:`Neutral` of ``(n, K, D)`` image-coordinate landmarks without gaps
-    (:func:`fill_gaps`), from the neutral frames ``span``, with FAPU overrides ``fapu``."""
-    points = face_frame(landmarks[span])
+    (:func:`fill_gaps`), from the frames of ``span`` that had a face (not in ``lost``, the
+    filled ones), with FAPU overrides ``fapu``. TrackingError when none of them had one."""
+    frames = neutral_frames(span, lost)
+    points = face_frame(landmarks[frames])
     image_rest = points.mean(axis=0)
     level = _levelling(image_rest, layout)
     rest = _remove_pose(points, layout, image_rest)[0].mean(axis=0) @ level.T

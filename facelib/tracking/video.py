@@ -2,8 +2,9 @@
 MediaPipe, and the whole path from a video file to a FapStream.
 
 Frames where no face is found are NaN in the landmark track (interpolated later and named in
-a :class:`~facelib.errors.TrackingWarning`); frames with several faces keep the largest and
-are named too.
+a :class:`~facelib.errors.TrackingWarning`), and so are the two either side of a longer loss
+(the face leaving or entering the picture); frames with several faces follow the face
+tracked before (the largest at first) and are named too.
 """
 
 from __future__ import annotations
@@ -24,7 +25,6 @@ from facelib.checks import check_count
 from facelib.errors import MissingExtraError, TrackingError, TrackingWarning
 from facelib.tracking.browimage import track_brows
 from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
-from facelib.tracking.headframe import neutral_span
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.observation import ObservationModel, default_observation
 
@@ -54,19 +54,48 @@ class VideoTrack:
     path: the video.
     info: its frame rate and size.
     landmarks: ``(n_frames, 478, 3) float64`` pixels (column, row, depth); NaN where no
-        face was found.
+        face was found, and in the two frames either side of a loss of five or more (the
+        face leaving or entering the picture, read with a wrong pose).
     n_faces: ``(n_frames,) int16`` faces seen per frame.
+    light: ``(n_frames,) float64`` the mean grey level (0-255) inside each frame's face
+        box; NaN where no face was found.
     """
 
     path: Path
     info: VideoInfo
     landmarks: np.ndarray
     n_faces: np.ndarray
+    light: np.ndarray
 
     @property
     def lost_frames(self) -> tuple[int, ...]:
-        """Frames with no face."""
-        return tuple(int(i) for i in np.flatnonzero(self.n_faces == 0))
+        """Frames with no face (NaN landmarks)."""
+        return tuple(int(i) for i in np.flatnonzero(~self._found))
+
+    @property
+    def _found(self) -> np.ndarray:
+        return np.asarray(np.isfinite(self.landmarks).all(axis=(1, 2)))
+
+    @property
+    def first_lit_face(self) -> int:
+        """The first frame whose face is at least 0.8 times as bright as the median face:
+        the default neutral (MediaPipe reads the dim faces of a fade-in poorly)."""
+        found = np.flatnonzero(self._found)
+        light = self.light[found]
+        if np.isfinite(light).any():
+            found = found[light >= 0.8 * np.nanmedian(light)]
+        return int(found[0])
+
+
+def _face_light(image: np.ndarray, box: np.ndarray) -> float:
+    """Mean grey level (0-255) of ``image`` ``(H, W, 3) uint8`` inside the face ``box``
+    ``(left, top, right, bottom)`` pixels, clipped to the image."""
+    height, width = image.shape[:2]
+    left, right = (int(np.clip(v, 0, width)) for v in box[0::2])
+    top, bottom = (int(np.clip(v, 0, height)) for v in box[1::2])
+    if right <= left or bottom <= top:
+        return float("nan")
+    return float(image[top:bottom, left:right].mean())
 
 
 def _imageio_ffmpeg() -> Any:
@@ -95,7 +124,8 @@ def _start(path: Path, rate: float | None = None) -> tuple[Any, dict[str, Any]]:
         return reader, next(reader)
     except (OSError, RuntimeError, StopIteration) as exc:
         reader.close()
-        raise TrackingError(f"ffmpeg cannot read a video stream from it ({exc})".splitlines()[0],
+        first = (str(exc).strip().splitlines() or ["no message"])[0]
+        raise TrackingError(f"ffmpeg cannot read a video stream from it ({first})",
                             path=path) from exc
     finally:
         ffmpeg_log.removeFilter(_not_turned)
@@ -155,7 +185,8 @@ def extract_audio(video: str | os.PathLike[str], wav: str | os.PathLike[str]) ->
 
 def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
                 max_faces: int = 2) -> VideoTrack:
-    """Track the largest face through a video with MediaPipe's face mesh.
+    """Track a face through a video with MediaPipe's face mesh (the largest at first, then
+    the one overlapping it most: :mod:`~facelib.tracking.mediapipe`).
 
     Raises TrackingError if the video has no frames or no face in any frame; warns
     (:class:`TrackingWarning`) naming the frames with several faces.
@@ -164,6 +195,7 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
     limit = None if max_frames is None else check_count("max_frames", max_frames, low=1)
     points: list[np.ndarray] = []
     counts: list[int] = []
+    light: list[float] = []
     lost = np.full((N_LANDMARKS, 3), np.nan)
     with FaceMeshTracker(video=True, max_faces=max_faces) as tracker:
         for i, image in enumerate(frames):
@@ -172,6 +204,7 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
             found = tracker.detect(image)
             points.append(lost if found is None else found.points)
             counts.append(0 if found is None else found.n_faces)
+            light.append(float("nan") if found is None else _face_light(image, found.box))
     if not points:
         raise TrackingError("the video has no frames", path=Path(path))
     n_faces = np.array(counts, np.int16)
@@ -181,18 +214,46 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
     several = np.flatnonzero(n_faces > 1)
     if several.size:
         warnings.warn(TrackingWarning(
-            f"{Path(path).name}: several faces in frames {frame_spans(several)}; tracked "
-            "the largest"), stacklevel=2)
-    return VideoTrack(Path(path), info, np.stack(points), n_faces)
+            f"{Path(path).name}: several faces in frames {frame_spans(several)}; followed "
+            "the one tracked before (the largest at first)"), stacklevel=2)
+    landmarks = np.stack(points)
+    edges = np.flatnonzero(_beside_losses(n_faces > 0))
+    if edges.size:
+        landmarks[edges] = np.nan
+        warnings.warn(TrackingWarning(
+            f"{Path(path).name}: frames {frame_spans(edges)} taken as lost too: the face "
+            "leaves or enters the picture beside them"), stacklevel=2)
+    return VideoTrack(Path(path), info, landmarks, n_faces, np.array(light))
+
+
+_LONG_LOSS = 5
+"""Frames without a face that make a loss (the face left the picture), not a dropout."""
+_BESIDE_LOSS = 2
+"""Frames either side of a loss taken as lost too."""
+
+
+def _beside_losses(found: np.ndarray) -> np.ndarray:
+    """``(n,) bool`` the frames with a face (``found``) within two frames of a loss of at
+    least five: MediaPipe follows a face that leaves or enters the picture quickly with a
+    wrong pose (a gaping jaw, a sideways look) for a frame or two, which would otherwise be
+    held through the loss."""
+    beside = np.zeros(len(found), bool)
+    edges = np.flatnonzero(np.diff(np.concatenate([[1], found.astype(np.int8), [1]])))
+    for start, stop in zip(edges[::2], edges[1::2], strict=True):  # runs of lost frames
+        if stop - start >= _LONG_LOSS:
+            beside[max(0, start - _BESIDE_LOSS):start] = True
+            beside[stop:stop + _BESIDE_LOSS] = True
+    return beside & found
 
 
 def video_brows(path: str | os.PathLike[str], landmarks: np.ndarray, *,
-                neutral: tuple[int, int], model: ObservationModel | None = None
-                ) -> np.ndarray:
+                neutral: int | tuple[int, int] | None = None,
+                model: ObservationModel | None = None) -> np.ndarray:
     """``(n, 4)`` the brows' image shifts (:mod:`~facelib.tracking.browimage`) of the
     video's first ``n`` frames, tracked as ``(n, 478, 3)`` ``landmarks`` with the neutral
-    frames ``(start, stop)``; ``model``: the observation model whose pose correction the
-    brows are sampled with (default: the packaged one). Reads the video twice more."""
+    frame(s) as for :func:`~facelib.tracking.faps.measure_faps`; ``model``: the
+    observation model whose pose correction the brows are sampled with (default: the
+    packaged one). Reads the video twice more."""
     def frames() -> Iterator[np.ndarray]:
         return islice(read_video(path)[1], len(landmarks))
 
@@ -203,15 +264,16 @@ def video_brows(path: str | os.PathLike[str], landmarks: np.ndarray, *,
 def track_video_faps(path: str | os.PathLike[str], *, max_frames: int | None = None,
                      **options: Any) -> tuple[VideoTrack, TrackedFaps]:
     """:func:`track_video`, then :func:`~facelib.tracking.faps.measure_faps` at the video's
-    frame rate (``options`` go to it: ``neutral``, ``fapu``, ``smooth``, ``states``) with
+    frame rate (``options`` go to it: ``neutral``, by default the first frame with a
+    well-lit face, :attr:`VideoTrack.first_lit_face`; ``fapu``, ``smooth``, ``states``) with
     the brows' image shifts (:func:`video_brows`) for the learned model (``rig``
     ``"auto"``, ``"observed"`` or an observation model) unless ``brows=None`` is given."""
     track = track_video(path, max_frames=max_frames)
+    options.setdefault("neutral", track.first_lit_face)
     rig = options.get("rig", "auto")
     if "brows" not in options and (rig in ("auto", "observed")
                                    or isinstance(rig, ObservationModel)):
-        span = neutral_span(options.get("neutral", 0), len(track.landmarks))
-        options["brows"] = video_brows(path, track.landmarks, neutral=(span.start, span.stop),
+        options["brows"] = video_brows(path, track.landmarks, neutral=options.get("neutral"),
                                        model=rig if isinstance(rig, ObservationModel) else None)
     return track, measure_faps(track.landmarks, fps=track.info.fps, layout="mediapipe",
                                **options)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from facelib.engine.rigid import rotation_matrices
-from facelib.errors import TrackingError, TrackingWarning
+from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.mpeg4 import ANGLE_UNIT
 from facelib.tracking.faps import fill_gaps, measure_faps
 from facelib.tracking.layouts import feature_point_layout, landmark_layout, layout_names
@@ -195,6 +195,27 @@ def test_lost_frames_are_interpolated_and_named():
     assert jaw[4] == pytest.approx((jaw[2] + jaw[5]) / 2 + (jaw[5] - jaw[2]) / 6, rel=1e-6)
     with pytest.raises(TrackingError, match="no face in any"):
         fill_gaps(np.full((4, 3, 2), np.nan))
+
+
+def test_the_neutral_is_made_of_frames_with_a_face():
+    """By default the neutral is the first frame with a face; a span keeps its frames with
+    a face; a span without one is refused, named."""
+    points = track(8)
+    points[:, IDS.index("2.1"), 1] += np.arange(8) * 2.0  # the jaw opens from frame 0
+    lost = points.copy()
+    lost[:3] = np.nan
+    with pytest.warns(TrackingWarning, match="the neutral is frame 3, the first with a face"):
+        first = faps(lost).stream.values
+    np.testing.assert_allclose(first[3:], faps(points[3:]).stream.values, atol=1e-9)
+    with pytest.warns(TrackingWarning, match="frames 0-2 of 8"):
+        span = faps(lost, neutral=(0, 5)).stream.values
+    np.testing.assert_allclose(span[3:], faps(points[3:], neutral=(0, 2)).stream.values,
+                               atol=1e-9)
+    with pytest.warns(TrackingWarning), pytest.raises(TrackingError,
+                                                      match="no face in the neutral frames 0-2"):
+        faps(lost, neutral=(0, 3))
+    with pytest.raises(ParameterError, match="empty span"):
+        faps(points, neutral=(4, 4))
 
 
 def test_bad_shapes_name_the_problem():

@@ -45,6 +45,24 @@ def test_two_faces_keeps_the_largest(default_head_render):
     assert found.box[2] < 640  # the big face, on the left half
 
 
+def test_a_video_follows_its_face_when_a_larger_one_comes(default_head_render):
+    """In a video the face tracked so far is kept when a second, larger one appears: a
+    colleague leaning in closer does not take over the track."""
+    image, _ = default_head_render
+    from PIL import Image
+
+    small = np.asarray(Image.fromarray(image).resize((480, 360)))
+    alone = np.zeros((480, 1280, 3), np.uint8)
+    alone[60:420, 720:1200] = small
+    joined = alone.copy()
+    joined[:, :640] = image
+    with FaceMeshTracker(video=True, max_faces=3) as tracker:
+        found = [tracker.detect(frame) for frame in [alone] * 3 + [joined] * 3]
+    assert all(f is not None for f in found)
+    assert [f.n_faces for f in found] == [1, 1, 1, 2, 2, 2]
+    assert all(f.box[0] > 640 for f in found)  # the small face, on the right half
+
+
 def test_no_face_and_bad_images():
     blank = np.full((240, 320, 3), 40, np.uint8)
     with pytest.raises(TrackingError, match="no face"):

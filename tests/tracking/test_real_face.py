@@ -135,3 +135,30 @@ def test_nothing_else_moves(clip):
     assert change[:, np.array(lids) - 1].max() < 150
     gaze = np.degrees(values[:, 22:26] * ANGLE_UNIT)
     assert np.abs(gaze).max() < 8.0
+
+
+def test_black_frames_before_the_face_make_no_neutral():
+    """A clip that starts black: the neutral is the first frame with a face, and the brows'
+    templates come from it, not from the black frames (they once read a raise of 145)."""
+    pytest.importorskip("mediapipe")
+    import cv2
+
+    from facelib.tracking.browimage import track_brows
+    from facelib.tracking.faps import measure_faps
+    from facelib.tracking.mediapipe import FaceMeshTracker
+    from facelib.tracking.observation import default_observation
+
+    photo = cv2.cvtColor(cv2.imread(str(PHOTO)), cv2.COLOR_BGR2RGB)
+    face = cv2.warpAffine(photo, _placement(0.0, np.zeros(2), 1.0), (640, 480),
+                          borderMode=cv2.BORDER_REPLICATE)
+    frames = [np.zeros_like(face)] * 6 + [face] * 10
+    with FaceMeshTracker(video=True, max_faces=1) as tracker:
+        found = [tracker.detect(frame) for frame in frames]
+    landmarks = np.stack([np.full((478, 3), np.nan) if f is None else f.points for f in found])
+    assert np.isnan(landmarks[:6]).all() and np.isfinite(landmarks[6:]).all()
+    shifts = track_brows(lambda: iter(frames), landmarks, neutral=None,
+                         model=default_observation())
+    assert np.abs(shifts[6:]).max() < 0.03  # ES0: under 3 pixels (MediaPipe settles)
+    with pytest.warns(UserWarning, match="the neutral is frame 6"):
+        faps = measure_faps(landmarks, fps=FPS, brows=shifts)
+    assert np.abs(faps.stream.values[6:, 30:32]).max() < 25

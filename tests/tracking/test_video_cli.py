@@ -66,7 +66,8 @@ def test_track_reports_bad_videos(tmp_path, capsys):
     fake = tmp_path / "fake.mp4"
     fake.write_text("not a video")
     assert main(["track", str(fake), "-o", str(tmp_path / "a.fap")]) == 1
-    assert "cannot read a video stream" in capsys.readouterr().err
+    assert "cannot read a video stream from it (Could not load meta information)" in (
+        capsys.readouterr().err)
     blank = tmp_path / "blank.mp4"
     writer = open_writer(blank, fps=25, width=320, height=240)
     for _ in range(5):
@@ -107,7 +108,7 @@ def test_lost_stretch_and_a_second_face_are_named(face_video, tmp_path, capsys):
     err = capsys.readouterr().err
     assert status == 0, err
     assert "no face in frames 5-7 of 16; interpolated" in err
-    assert "several faces in frames 10-12; tracked the largest" in err
+    assert "several faces in frames 10-12; followed the one tracked before" in err
     assert read_fap(tmp_path / "e.fap").n_frames == N
 
 
@@ -213,3 +214,25 @@ def test_landmarks_at_a_rate_that_is_not_whole(face_video, tmp_path, capsys):
     assert stream.fps == 30 and abs(stream.duration - N / 29.97) < 1 / 30
     jaw = read_fap(tmp_path / "at25.fap").values[:, 2].astype(float)
     assert abs(stream.values[:, 2].max() - jaw.max()) < 0.05 * jaw.max()
+
+
+def test_frames_beside_a_loss_are_lost_too_and_a_dim_start_is_not_the_neutral(face_video,
+                                                                              tmp_path):
+    """The face gone for 8 frames: the two frames either side are taken as lost too (a face
+    leaving or entering the picture is read with a wrong pose) and named; a dim first face
+    (a fade-in) is not the default neutral."""
+    from facelib.rendering.video import open_writer
+    from facelib.tracking.video import VideoTrack, read_video, track_video
+
+    _, frames = read_video(face_video)
+    writer = open_writer(tmp_path / "gone.mp4", fps=25, width=640, height=480)
+    for i, image in enumerate(frames):
+        writer.write(np.full_like(image, 40) if 5 <= i <= 12 else image)
+    writer.commit()
+    with pytest.warns(UserWarning, match="frames 3-4, 13-14 taken as lost too"):
+        track = track_video(tmp_path / "gone.mp4")
+    assert track.lost_frames == tuple(range(3, 15))
+    light = np.array([np.nan, 20, 60, 110, 120, 118, 121])
+    dim = VideoTrack(track.path, track.info, np.zeros((7, 478, 3)), np.ones(7, np.int16),
+                     light)
+    assert dim.first_lit_face == 3
