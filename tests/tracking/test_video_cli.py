@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -66,8 +68,8 @@ def test_track_reports_bad_videos(tmp_path, capsys):
     fake = tmp_path / "fake.mp4"
     fake.write_text("not a video")
     assert main(["track", str(fake), "-o", str(tmp_path / "a.fap")]) == 1
-    assert "cannot read a video stream from it (Could not load meta information)" in (
-        capsys.readouterr().err)
+    assert re.search(r"cannot read a video stream from it \([^()\n]+\)\n",
+                     capsys.readouterr().err)
     blank = tmp_path / "blank.mp4"
     writer = open_writer(blank, fps=25, width=320, height=240)
     for _ in range(5):
