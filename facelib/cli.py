@@ -719,8 +719,9 @@ def _track(args: argparse.Namespace, console: Console) -> int:
     stream = result.stream
     if stream.fps != round(stream.fps):  # a camera's measured rate, a landmark file's
         stream = stream.resample(max(1, round(stream.fps)))
-        console.status(f"resampled from {result.stream.fps:.4g} to {stream.fps:g} frames a "
-                       "second: a .fap holds whole rates")
+        if abs(result.stream.fps - stream.fps) > 1e-3 * stream.fps:  # not timestamps' noise
+            console.status(f"resampled from {result.stream.fps:.4g} to {stream.fps:g} frames "
+                           "a second: a .fap holds whole rates")
     _emit_text(format_fap(stream, dialect=args.dialect, name=Path(args.output).stem),
                args.output, console, f"({stream.n_frames} frames, {stream.duration:.2f} s)")
     if args.render and source.video is not None:
