@@ -598,7 +598,7 @@ def _add_track(commands: Any) -> None:
     track.add_argument("--show-landmarks", action="store_true",
                        help="draw the tracked landmarks on the mirror's source side")
     track.add_argument("--neutral", help="neutral frame N or span START:STOP (default: the "
-                       "first frame with a face)")
+                       "first frame with a face; in a video, with a well-lit face)")
     track.add_argument("--pucker", action="append", metavar="START:STOP",
                        help="frames labelled pucker (eq. 4.17 high-level state); repeatable")
     track.add_argument("--no-smooth", action="store_true", help="skip the One Euro filter")

@@ -80,7 +80,9 @@ class TrackedFaps:
     ----------
     stream: the FAPs, ``(n, 84)``.
     fapu: the user's FAPU in the landmarks' unit per FAP unit (``AU`` in radians).
-    pose: the per-frame head fit (None when only translation was corrected).
+    pose: the per-frame head fit, its axes the neutral head's, levelled (rotations
+        ``L R L^T``, translations ``L t`` with ``L`` the neutral's ``level``; None when
+        only translation was corrected).
     filled_frames: frames with no landmarks, interpolated from their neighbours.
     """
 

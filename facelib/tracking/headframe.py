@@ -102,10 +102,13 @@ def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
 def neutral_span(neutral: int | tuple[int, int] | None, n: int, *,
                  lost: Collection[int] = ()) -> slice:
     """The neutral frame or ``(start, stop)`` span as a slice, None: the first of ``n``
-    frames with a face (not in ``lost``). ParameterError for an empty span or one outside
-    the ``n`` frames."""
+    frames with a face (not in ``lost``; TrackingError if there is none). ParameterError for
+    an empty span or one outside the ``n`` frames."""
     if neutral is None:
-        first = next((i for i in range(n) if i not in set(lost)), 0)
+        missing = set(lost)
+        first = next((i for i in range(n) if i not in missing), None)
+        if first is None:
+            raise TrackingError(f"no face in any of the {n} frames")
         return slice(first, first + 1)
     start, stop = (neutral, neutral + 1) if isinstance(neutral, int) else neutral
     if start >= stop:

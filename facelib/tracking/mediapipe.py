@@ -16,6 +16,7 @@ import logging
 import os
 import sys
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -58,26 +59,39 @@ def _face_mesh_module() -> Any:
     return face_mesh
 
 
+_REDIRECT = threading.Lock()
+"""Held while fd 2 points elsewhere: trackers started in several threads take turns."""
+
+
 @contextmanager
 def _native_stderr_logged() -> Iterator[None]:
     """Send what C++ code writes to the process's stderr meanwhile (MediaPipe's graph, as it
     starts and as it first sees a face, prints TensorFlow Lite's delegate notice and absl
     warnings about itself) to this module's log at INFO instead: a pipeline's stderr keeps
     facelib's own messages, and ``facelib -v`` still shows them. Anything the process
-    writes to stderr in the meantime, from any thread, goes the same way."""
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile() as sink:
-        os.dup2(sink.fileno(), 2)
+    writes to stderr in the meantime, from any thread, goes the same way. A process whose
+    stderr is closed is left as it is."""
+    with _REDIRECT:
+        if sys.stderr is not None:
+            sys.stderr.flush()
         try:
+            saved = os.dup(2)
+        except OSError:  # no stderr to redirect
+            saved = -1
+        if saved < 0:
             yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            sink.seek(0)
-            for line in sink.read().decode(errors="replace").splitlines():
-                if line.strip():
-                    log.info("mediapipe: %s", line.strip())
+            return
+        with tempfile.TemporaryFile() as sink:
+            os.dup2(sink.fileno(), 2)
+            try:
+                yield
+            finally:
+                os.dup2(saved, 2)
+                os.close(saved)
+                sink.seek(0)
+                for line in sink.read().decode(errors="replace").splitlines():
+                    if line.strip():
+                        log.info("mediapipe: %s", line.strip())
 
 
 def _area(box: np.ndarray) -> float:
@@ -86,10 +100,13 @@ def _area(box: np.ndarray) -> float:
 
 def _pick(boxes: list[np.ndarray], previous: np.ndarray | None) -> int:
     """Which of the faces' ``(4,)`` boxes (left, top, right, bottom) to keep: the one that
-    overlaps ``previous`` (the box kept in an earlier frame) most, else the largest."""
+    overlaps ``previous`` (the box kept in an earlier frame) most, as intersection over
+    union, else the largest."""
     if previous is not None:
-        overlaps = [_area(np.concatenate([np.maximum(b[:2], previous[:2]),
-                                          np.minimum(b[2:], previous[2:])])) for b in boxes]
+        shared = [_area(np.concatenate([np.maximum(b[:2], previous[:2]),
+                                        np.minimum(b[2:], previous[2:])])) for b in boxes]
+        overlaps = [c / (_area(b) + _area(previous) - c) for b, c in zip(boxes, shared,
+                                                                      strict=True)]
         if max(overlaps) > 0:
             return int(np.argmax(overlaps))
     return int(np.argmax([_area(b) for b in boxes]))
@@ -131,7 +148,11 @@ class FaceMeshTracker:
                 static_image_mode=not video, max_num_faces=int(max_faces),
                 refine_landmarks=True, min_detection_confidence=detect,
                 min_tracking_confidence=track)
-            self._mesh.process(np.zeros((64, 64, 3), np.uint8))  # returns once it runs
+            try:
+                self._mesh.process(np.zeros((64, 64, 3), np.uint8))  # returns once it runs
+            except BaseException:
+                self._mesh.close()
+                raise
         self._seen_face = False
         self._video = video
         self._previous: np.ndarray | None = None  # the box of the face kept last

@@ -218,6 +218,10 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
             "the one tracked before (the largest at first)"), stacklevel=2)
     landmarks = np.stack(points)
     edges = np.flatnonzero(_beside_losses(n_faces > 0))
+    if edges.size == np.count_nonzero(n_faces):
+        raise TrackingError(f"the face is seen only in frames {frame_spans(edges)} of "
+                            f"{len(points)}, as it enters or leaves the picture",
+                            path=Path(path))
     if edges.size:
         landmarks[edges] = np.nan
         warnings.warn(TrackingWarning(

@@ -63,6 +63,18 @@ def test_a_video_follows_its_face_when_a_larger_one_comes(default_head_render):
     assert all(f.box[0] > 640 for f in found)  # the small face, on the right half
 
 
+def test_the_face_kept_is_the_one_overlapping_most():
+    """Overlap as intersection over union: the same face moved a little wins over a larger
+    box around it; with nothing kept before, or no overlap, the largest."""
+    from facelib.tracking.mediapipe import _pick
+
+    before = np.array([100.0, 100, 200, 220])
+    moved, around = before + 4, np.array([60.0, 60, 260, 300])
+    assert _pick([around, moved], before) == 1
+    assert _pick([around, moved], None) == 0
+    assert _pick([moved, around], np.array([400.0, 400, 450, 460])) == 1
+
+
 def test_no_face_and_bad_images():
     blank = np.full((240, 320, 3), 40, np.uint8)
     with pytest.raises(TrackingError, match="no face"):

@@ -238,3 +238,33 @@ def test_frames_beside_a_loss_are_lost_too_and_a_dim_start_is_not_the_neutral(fa
     dim = VideoTrack(track.path, track.info, np.zeros((7, 478, 3)), np.ones(7, np.int16),
                      light)
     assert dim.first_lit_face == 3
+
+
+def test_a_face_seen_only_beside_losses_is_no_track(face_video, tmp_path, capsys):
+    """Eight empty frames, then two with the face: those two are taken as lost (the face
+    entering the picture), which leaves no face; the command says so, without a trace."""
+    from facelib.rendering.video import open_writer
+    from facelib.tracking.video import read_video
+
+    _, frames = read_video(face_video)
+    writer = open_writer(tmp_path / "late.mp4", fps=25, width=640, height=480)
+    for i, image in enumerate(frames):
+        if i < 10:
+            writer.write(np.full_like(image, 40) if i < 8 else image)
+    writer.commit()
+    assert main(["track", str(tmp_path / "late.mp4"), "-o", str(tmp_path / "l.fap")]) == 1
+    assert "the face is seen only in frames 8-9 of 10" in capsys.readouterr().err
+    assert not (tmp_path / "l.fap").exists()
+
+
+@pytest.mark.parametrize(("found", "beside"), [
+    ("0000011111", "0000011000"),            # the face enters after a loss at the start
+    ("1111100000", "0001100000"),            # and leaves before one at the end
+    ("11000001100000111", "11000001100000110"),  # two losses close together
+    ("1100001111", "0000000000"),            # four frames lost: a dropout, left alone
+])
+def test_frames_beside_losses(found, beside):
+    from facelib.tracking.video import _beside_losses
+
+    flags = np.array([c == "1" for c in found])
+    assert "".join("1" if b else "0" for b in _beside_losses(flags)) == beside
