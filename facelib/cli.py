@@ -640,10 +640,14 @@ def _track_source(args: argparse.Namespace, console: Console) -> _Tracked:
         from facelib.tracking.files import read_landmarks
 
         file = read_landmarks(source)
-        fps = args.fps or file.fps
+        fps = file.fps if args.fps is None else args.fps
         layout = args.layout or file.layout
+        missing = [f"--{name} ({why})" for name, value, why in (
+            ("fps", fps, "the file does not say its frame rate"),
+            ("layout", layout, f"no packaged layout has {file.landmarks.shape[1]} points"))
+            if value is None]
         if fps is None or layout is None:
-            raise FacelibError(f"{source}: give --fps and --layout (the file does not say)")
+            raise FacelibError(f"{source}: give " + " and ".join(missing))
         return _Tracked(file.landmarks, fps, layout, _neutral(args))
     from facelib.tracking.video import track_video, video_brows
 

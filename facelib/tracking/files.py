@@ -3,13 +3,20 @@
 Read by :func:`read_landmarks` (the format is told by the suffix and the header):
 
 - ``.csv`` with columns ``frame, point, x, y[, z]`` (facelib's, and a generic long table;
-  an optional ``# fps: 30`` comment line gives the rate);
+  points numbered from 0, or from 1 as in iBUG's figure when no point 0 appears; an
+  optional ``# fps: 30`` or ``# fps: 30000/1001`` comment line gives the rate);
 - ``.csv`` written by OpenFace 2.x ``FeatureExtraction`` (``frame, face_id, timestamp,
-  confidence, success, ..., x_0 ... x_67, y_0 ... y_67[, X_0 ... Z_67]``): the 2-D columns,
-  rows with ``success`` 0 as lost frames, the rate from the timestamps, the first face id;
+  confidence, success, ..., x_0 ... x_67, y_0 ... y_67[, X_0 ... Z_67]``): the 2-D columns
+  of the lowest face id, rows placed by their ``frame`` (a frame without a row, or with
+  ``success`` 0, is lost), the rate from the timestamps over the whole track (OpenFace
+  rounds them to the millisecond) snapped to a common camera rate within 1 %;
 - ``.json``: ``{"fps": 30, "frames": [[[x, y], ...], null, ...]}`` or a bare list of frames
-  (dlib/iBUG 68-point lists; null is a lost frame);
-- ``.pts`` (iBUG 300-W), one file per frame, or a folder of them in name order.
+  (dlib/iBUG 68-point lists; null or ``[]`` is a lost frame);
+- ``.pts`` (iBUG 300-W), one file per frame, or a folder of them ordered by the last number
+  in their names (a missing number is a lost frame), else by name.
+
+Text may start with a UTF-8 byte-order mark (as Excel writes CSV). Coordinates all within
+0-1 (normalised, as MediaPipe's Python API gives them) are refused.
 
 Coordinates are image pixels (column, row[, depth]). Frames with missing points, or with a
 different point count, are lost frames (NaN, named in a warning); a file with no usable
@@ -31,7 +38,7 @@ import numpy as np
 
 from facelib.atomic import write_text_atomic
 from facelib.checks import check_fps
-from facelib.errors import TrackingError, TrackingWarning
+from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.tracking.faps import frame_spans
 
 __all__ = ["LandmarkFile", "guess_layout", "read_landmarks", "write_landmarks_csv"]
@@ -77,18 +84,44 @@ def _finish(path: Path, frames: list[np.ndarray | None], fps: float | None) -> L
     for i, f in enumerate(frames):
         if i not in bad and f is not None:
             out[i] = f
+    plane = out[..., :2][np.isfinite(out[..., :2])]
+    if plane.size and np.abs(plane).max() <= 1.5:
+        raise TrackingError("every coordinate is within 0-1: these look normalised; give "
+                            "image pixels (x times the width, y times the height)", path=path)
     return LandmarkFile(path, out, fps, guess_layout(shape[0]))
 
 
-def _fps_comment(text: str) -> float | None:
-    match = re.search(r"^#\s*fps\s*[:=]\s*([0-9.eE+-]+)", text, re.MULTILINE)
-    return check_fps(float(match.group(1))) if match else None
+_COMMON_RATES = (24000 / 1001, 24.0, 25.0, 30000 / 1001, 30.0, 48.0, 50.0, 60000 / 1001,
+                 60.0, 90.0, 100.0, 120.0, 240.0)
+"""Camera and video frame rates a rate measured from rounded timestamps is snapped to."""
+
+
+def _snapped(rate: float) -> float:
+    """``rate`` (frames a second, measured) as the common rate within 1 % of it, if any."""
+    near = min(_COMMON_RATES, key=lambda r: abs(r - rate))
+    return near if abs(near - rate) <= 0.01 * near else rate
+
+
+def _fps_comment(path: Path, text: str) -> float | None:
+    """The rate of a ``# fps: 30`` (or ``30000/1001``) comment line, if any."""
+    for line, row in enumerate(text.splitlines(), start=1):
+        match = re.match(r"\s*#\s*fps\s*[:=]\s*(\S+)", row)
+        if match:
+            try:
+                top, _, bottom = match.group(1).partition("/")
+                return check_fps(float(top) / (float(bottom) if bottom else 1.0))
+            except (ValueError, ZeroDivisionError, ParameterError):
+                raise TrackingError(f"bad frame rate {match.group(1)!r}", path=path,
+                                    line=line) from None
+    return None
 
 
 def _read_long_csv(path: Path, text: str) -> LandmarkFile:
     lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
              if ln.strip() and not ln.lstrip().startswith("#")]
     rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines))))
+    if len(rows) < 2:
+        raise TrackingError("no landmark rows after the header", path=path)
     header = [h.strip().lower() for h in rows[0]]
     dim = 3 if "z" in header else 2
     cols = [header.index(c) for c in ("frame", "point", "x", "y", "z")[: 2 + dim]]
@@ -102,6 +135,8 @@ def _read_long_csv(path: Path, text: str) -> LandmarkFile:
         if frame < 0 or point < 0:
             raise TrackingError("frame and point must be >= 0", path=path, line=line)
         table.setdefault(frame, {})[point] = xyz
+    if all(0 not in pts for pts in table.values()):  # numbered from 1, as iBUG's figure
+        table = {f: {p - 1: xyz for p, xyz in pts.items()} for f, pts in table.items()}
     n_points = 1 + max(p for pts in table.values() for p in pts)
     frames: list[np.ndarray | None] = []
     for frame in range(1 + max(table)):
@@ -113,7 +148,7 @@ def _read_long_csv(path: Path, text: str) -> LandmarkFile:
         for p, xyz in pts.items():
             arr[p] = xyz
         frames.append(arr)
-    return _finish(path, frames, _fps_comment(text))
+    return _finish(path, frames, _fps_comment(path, text))
 
 
 def _read_openface(path: Path, text: str) -> LandmarkFile:
@@ -123,23 +158,31 @@ def _read_openface(path: Path, text: str) -> LandmarkFile:
     ys = sorted((int(h[2:]), i) for i, h in enumerate(header) if re.fullmatch(r"y_\d+", h))
     if len(xs) != len(ys) or not xs:
         raise TrackingError("OpenFace CSV without matching x_i / y_i columns", path=path, line=1)
-    col = {name: header.index(name) for name in ("timestamp", "success", "face_id")
+    col = {name: header.index(name) for name in ("frame", "timestamp", "success", "face_id")
            if name in header}
-    frames: list[np.ndarray | None] = []
-    times: list[float] = []
+    rows: list[tuple[int, float, int, np.ndarray | None]] = []  # frame, time, face, points
     for line, cells in enumerate(reader, start=2):
+        if not any(c.strip() for c in cells):
+            continue
         try:
-            if "face_id" in col and int(float(cells[col["face_id"]])) != 0:
-                continue
             ok = "success" not in col or float(cells[col["success"]]) > 0
             pts = np.array([[float(cells[i]) for _, i in xs], [float(cells[i]) for _, i in ys]]).T
-            if "timestamp" in col:
-                times.append(float(cells[col["timestamp"]]))
+            rows.append((int(float(cells[col["frame"]])) if "frame" in col else len(rows),
+                         float(cells[col["timestamp"]]) if "timestamp" in col else np.nan,
+                         int(float(cells[col["face_id"]])) if "face_id" in col else 0,
+                         pts if ok else None))
         except (ValueError, IndexError):
             raise TrackingError("bad OpenFace row", path=path, line=line) from None
-        frames.append(pts if ok else None)
-    steps = np.diff(times)
-    fps = float(1 / np.median(steps)) if len(steps) and np.median(steps) > 0 else None
+    if not rows:
+        raise TrackingError("no landmark rows after the header", path=path)
+    face = min(r[2] for r in rows)  # the first face id
+    kept = {r[0]: r for r in rows if r[2] == face}
+    first = min(kept)
+    frames = [kept[f][3] if f in kept else None for f in range(first, max(kept) + 1)]
+    times = np.array([kept[f][1] for f in sorted(kept)])
+    span = np.ptp(np.array(sorted(kept)))
+    fps = (_snapped(span / (times[-1] - times[0]))
+           if span and np.isfinite(times).all() and times[-1] > times[0] else None)
     return _finish(path, frames, fps)
 
 
@@ -156,7 +199,7 @@ def _read_json(path: Path, text: str) -> LandmarkFile:
         raise TrackingError("expected a list of frames (or {'fps', 'frames'})", path=path)
     frames: list[np.ndarray | None] = []
     for i, frame in enumerate(doc):
-        if frame is None:
+        if frame is None or frame == []:  # no face
             frames.append(None)
             continue
         try:
@@ -171,7 +214,7 @@ def _read_json(path: Path, text: str) -> LandmarkFile:
 
 def _read_pts_file(path: Path) -> np.ndarray:
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise TrackingError(f"cannot read it: {exc}", path=path) from exc
     match = re.search(r"\{(.*)\}", text, re.DOTALL)
@@ -188,21 +231,36 @@ def _read_pts_file(path: Path) -> np.ndarray:
     return pts - 1.0  # .pts coordinates are 1-based (Matlab convention of 300-W)
 
 
+def _read_pts_folder(path: Path) -> LandmarkFile:
+    """A folder of ``.pts`` files, one per frame: in the order of the last number in their
+    names (``frame_9`` before ``frame_10``), a missing number a lost frame; in name order
+    when some name has no number."""
+    files = sorted(f for f in path.iterdir() if f.suffix.lower() == ".pts")
+    if not files:
+        raise TrackingError("folder holds no .pts files", path=path)
+    numbers = [re.findall(r"\d+", f.stem) for f in files]
+    if not all(numbers):
+        return _finish(path, [_read_pts_file(f) for f in files], None)
+    order = {int(n[-1]): f for n, f in zip(numbers, files, strict=True)}
+    if len(order) != len(files):
+        raise TrackingError("two .pts files have the same frame number", path=path)
+    first = min(order)
+    return _finish(path, [_read_pts_file(order[i]) if i in order else None
+                          for i in range(first, max(order) + 1)], None)
+
+
 def read_landmarks(path: str | os.PathLike[str]) -> LandmarkFile:
     """Read a landmark track (formats in the module docstring)."""
     path = Path(path)
     if path.is_dir():
-        files = sorted(path.glob("*.pts"))
-        if not files:
-            raise TrackingError("folder holds no .pts files", path=path)
-        return _finish(path, [_read_pts_file(f) for f in files], None)
+        return _read_pts_folder(path)
     if not path.is_file():
         raise TrackingError(f"landmark file {str(path)!r} does not exist")
     suffix = path.suffix.lower()
     if suffix == ".pts":
         return _finish(path, [_read_pts_file(path)], None)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # as Excel writes it, with a BOM
     except (OSError, UnicodeDecodeError) as exc:
         raise TrackingError(f"cannot read it: {exc}", path=path) from exc
     if suffix == ".json":

@@ -89,3 +89,84 @@ def test_json_lists_and_pts(tmp_path):
     (tmp_path / "e.json").write_text(json.dumps([[[1, 2, 3, 4]]]))
     with pytest.raises(TrackingError, match="frame 0 has shape"):
         read_landmarks(tmp_path / "e.json")
+
+
+def openface_lines(data: np.ndarray, fps: float, faces: dict[int, list[int]]) -> list[str]:
+    """OpenFace 2.x rows as FeatureExtraction writes them: ", " separators, timestamps
+    rounded to the millisecond, one row per face id (``faces``: frame index -> ids)."""
+    header = (["frame", " face_id", " timestamp", " confidence", " success"]
+              + [f" x_{i}" for i in range(68)] + [f" y_{i}" for i in range(68)])
+    lines = [",".join(header)]
+    for f in range(len(data)):
+        for face in faces.get(f, [0]):
+            cells = [f + 1, face, f"{f / fps:.3f}", 0.98, 1, *data[f, :, 0] + 50 * face,
+                     *data[f, :, 1]]
+            lines.append(", ".join(str(c) for c in cells))
+    return lines
+
+
+@pytest.mark.parametrize("fps", [24.0, 30.0, 60.0, 120.0])
+def test_openface_rate_from_rounded_timestamps(tmp_path, fps):
+    """The rate comes from the whole track's timestamps, which OpenFace rounds to the
+    millisecond (the median step once read 30 as 30.3 and 120 as 125)."""
+    (tmp_path / "of.csv").write_text("\n".join(openface_lines(random_track(300), fps, {})))
+    assert read_landmarks(tmp_path / "of.csv").fps == fps
+
+
+def test_openface_rows_are_placed_by_frame_and_face(tmp_path):
+    """Two people: the lowest face id is read; frames without its row are lost, not closed
+    up; a blank last line is no row; a file of face 1 alone is read."""
+    data = random_track(40)
+    faces = {f: ([1] if 20 <= f < 30 else [1, 0]) for f in range(40)}
+    (tmp_path / "two.csv").write_text("\n".join(openface_lines(data, 30, faces)) + "\n\n")
+    got = read_landmarks(tmp_path / "two.csv")
+    assert len(got.landmarks) == 40 and got.fps == 30
+    assert np.isnan(got.landmarks[20:30]).all() and np.isfinite(got.landmarks[30:]).all()
+    np.testing.assert_allclose(got.landmarks[35], data[35])
+    only = {f: [1] for f in range(40)}
+    (tmp_path / "one.csv").write_text("\n".join(openface_lines(data, 30, only)))
+    np.testing.assert_allclose(read_landmarks(tmp_path / "one.csv").landmarks[:, :, 0],
+                               data[:, :, 0] + 50)
+
+
+def test_pts_folder_in_frame_number_order(tmp_path):
+    """frame_9.pts comes before frame_10.pts, and a missing number is a lost frame."""
+    data = random_track(12)
+    for i in range(12):
+        if i != 5:
+            body = "\n".join(f"{x + 1} {y + 1}" for x, y in data[i])
+            (tmp_path / f"frame_{i + 1}.pts").write_text(
+                f"version: 1\nn_points: 68\n{{\n{body}\n}}\n")
+    got = read_landmarks(tmp_path)
+    assert len(got.landmarks) == 12 and np.isnan(got.landmarks[5]).all()
+    keep = [i for i in range(12) if i != 5]
+    np.testing.assert_allclose(got.landmarks[keep], data[keep])
+
+
+def test_rates_bom_empty_and_normalised_files(tmp_path):
+    rows = ["frame,point,x,y"] + [f"{f},{p},{100 + p},{200 + f}" for f in range(3)
+                                  for p in range(68)]
+    (tmp_path / "ntsc.csv").write_text("\ufeff# fps: 30000/1001\n" + "\n".join(rows))
+    assert read_landmarks(tmp_path / "ntsc.csv").fps == pytest.approx(30000 / 1001)
+    (tmp_path / "bad.csv").write_text("# source: a tracker\n# fps: 1e\n" + "\n".join(rows))
+    with pytest.raises(TrackingError, match=r"bad.csv:2: bad frame rate '1e'"):
+        read_landmarks(tmp_path / "bad.csv")
+    (tmp_path / "empty.csv").write_text("frame,point,x,y\n")
+    with pytest.raises(TrackingError, match="no landmark rows"):
+        read_landmarks(tmp_path / "empty.csv")
+    frames = [(random_track(1)[0] / 640).tolist(), []]
+    (tmp_path / "norm.json").write_text(json.dumps({"fps": 25, "frames": frames}))
+    with pytest.raises(TrackingError, match="look normalised"):
+        read_landmarks(tmp_path / "norm.json")
+    frames = [random_track(1)[0].tolist(), [], random_track(1)[0].tolist()]
+    (tmp_path / "gap.json").write_text(json.dumps(frames))
+    assert np.isnan(read_landmarks(tmp_path / "gap.json").landmarks[1]).all()
+
+
+def test_points_numbered_from_one(tmp_path):
+    """iBUG's figure numbers the 68 points 1-68: with no point 0 they are shifted."""
+    rows = ["frame,point,x,y"] + [f"{f},{p + 1},{100 + p},{200 + f}" for f in range(2)
+                                  for p in range(68)]
+    (tmp_path / "one.csv").write_text("\n".join(rows))
+    got = read_landmarks(tmp_path / "one.csv")
+    assert got.layout == "ibug68" and got.landmarks[1, 0].tolist() == [100, 201]
