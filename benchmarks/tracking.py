@@ -12,7 +12,8 @@ the correlation and gain of the recovered against the true curve, blink and lip-
 recall, for the learned observation model (the default, ``rig="observed"``) and, from the
 same landmarks, the default head's rig fit (``rig="default"``, the earlier method); then the
 same without the added head turns; after the first clip, landmarks to FAPs on its
-landmarks repeated to 4- and 20-minute tracks (frames/s and peak memory); then both on
+landmarks repeated to 4- and 20-minute tracks (frames/s and peak memory) and the
+4-minute one's landmark CSV read back (time and peak memory); then both on
 the SOMA-X head of ``examples/heads`` (set up with ``facelib.setup_face``), which neither
 model has seen; the stylised cartoon head with head turns; last
 ``examples/tracking/expressive.fdl`` (speech with surprise, worry, sadness, fear and anger,
@@ -28,9 +29,11 @@ touch where the source's do not).
 
 from __future__ import annotations
 
+import tempfile
 import time
 import tracemalloc
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -53,6 +56,7 @@ from facelib.tracking.closedloop import (
     with_head_turns,
 )
 from facelib.tracking.faps import measure_faps
+from facelib.tracking.files import read_landmarks, write_landmarks_csv
 from facelib.tracking.mediapipe import FaceMeshTracker
 from facelib.tracking.observation import default_observation
 from facelib.visemes.timeline import bilabial_spans
@@ -149,6 +153,22 @@ def long_tracks(landmarks: np.ndarray, fps: float, minutes: Sequence[float] = (4
         print(f"  {length:g}-minute track ({n} frames, landmarks {track.nbytes / 1e6:.0f} MB): "
               f"landmarks to FAPs {n / took:.0f} frames/s, {peak / 1e6:.0f} MB allocated at "
               "the peak beyond the landmarks")
+    landmark_csv(np.resize(landmarks, (round(minutes[0] * 60 * fps), *landmarks.shape[1:])),
+                 fps, minutes[0])
+
+
+def landmark_csv(track: np.ndarray, fps: float, minutes: float) -> None:
+    """``--landmarks-out``'s CSV of ``track`` read back: time and peak memory."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = write_landmarks_csv(Path(folder) / "track.csv", track, fps=fps)
+        tracemalloc.start()
+        started = time.perf_counter()
+        read_landmarks(path)
+        took = time.perf_counter() - started
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        print(f"  its landmark CSV ({minutes:g} minutes, {path.stat().st_size / 1e6:.0f} MB) "
+              f"read in {took:.1f} s, {peak / 1e6:.0f} MB allocated at the peak")
 
 
 def main() -> None:

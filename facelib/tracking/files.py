@@ -4,7 +4,8 @@ Read by :func:`read_landmarks` (the format is told by the suffix and the header)
 
 - ``.csv`` with columns ``frame, point, x, y[, z]`` (facelib's, and a generic long table;
   points numbered from 0, or from 1 as in iBUG's figure when no point 0 appears; an
-  optional ``# fps: 30`` or ``# fps: 30000/1001`` comment line gives the rate);
+  optional ``# fps: 30`` or ``# fps: 30000/1001`` comment line before the rows gives the
+  rate);
 - ``.csv`` written by OpenFace 2.x ``FeatureExtraction`` (``frame, face_id, timestamp,
   confidence, success, ..., x_0 ... x_67, y_0 ... y_67[, X_0 ... Z_67]``): the 2-D columns
   of the lowest face id, rows placed by their ``frame`` (a frame without a row, or with
@@ -31,8 +32,10 @@ import json
 import os
 import re
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 
@@ -104,51 +107,72 @@ def _snapped(rate: float) -> float:
 
 def _fps_comment(path: Path, text: str) -> float | None:
     """The rate of a ``# fps: 30`` (or ``30000/1001``) comment line, if any."""
-    for line, row in enumerate(text.splitlines(), start=1):
-        match = re.match(r"\s*#\s*fps\s*[:=]\s*(\S+)", row)
-        if match:
-            try:
-                top, _, bottom = match.group(1).partition("/")
-                return check_fps(float(top) / (float(bottom) if bottom else 1.0))
-            except (ValueError, ZeroDivisionError, ParameterError):
-                raise TrackingError(f"bad frame rate {match.group(1)!r}", path=path,
-                                    line=line) from None
-    return None
+    match = re.search(r"^[ \t]*#[ \t]*fps[ \t]*[:=][ \t]*(\S+)", text, re.MULTILINE)
+    if match is None:
+        return None
+    try:
+        top, _, bottom = match.group(1).partition("/")
+        return check_fps(float(top) / (float(bottom) if bottom else 1.0))
+    except (ValueError, ZeroDivisionError, ParameterError):
+        raise TrackingError(f"bad frame rate {match.group(1)!r}", path=path,
+                            line=text.count("\n", 0, match.start()) + 1) from None
 
 
-def _read_long_csv(path: Path, text: str) -> LandmarkFile:
-    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
-             if ln.strip() and not ln.lstrip().startswith("#")]
-    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines))))
-    if len(rows) < 2:
-        raise TrackingError("no landmark rows after the header", path=path)
-    header = [h.strip().lower() for h in rows[0]]
+def _read_long_csv(path: Path, head: str) -> LandmarkFile:
+    """A ``frame, point, x, y[, z]`` table from the file (``head``: its first lines, with
+    the header and any ``# fps`` comment), parsed by numpy: a long recording's CSV holds
+    millions of rows; a bad row is found again line by line to name it."""
+    at, first = next((i, ln) for i, ln in _numbered_lines(head)
+                     if ln.strip() and not ln.lstrip().startswith("#"))
+    header = [h.strip().lower() for h in first.split(",")]
     dim = 3 if "z" in header else 2
     cols = [header.index(c) for c in ("frame", "point", "x", "y", "z")[: 2 + dim]]
-    table: dict[int, dict[int, list[float]]] = {}
-    for (line, _), cells in zip(lines[1:], rows[1:], strict=True):
+    try:
+        table = np.loadtxt(path, delimiter=",", comments="#", ndmin=2, skiprows=at,
+                           usecols=cols, encoding="utf-8-sig")
+    except ValueError:
+        _raise_bad_row(path, at, cols)
+    if not len(table):
+        raise TrackingError("no landmark rows after the header", path=path)
+    ids = table[:, :2]
+    if (ids != np.round(ids)).any() or (ids < 0).any():
+        _raise_bad_row(path, at, cols)
+    frame, point = ids.astype(np.int64).T
+    if not (point == 0).any():  # numbered from 1, as iBUG's figure
+        point = point - 1
+    out = np.full((frame.max() + 1, point.max() + 1, dim), np.nan)
+    out[frame, point] = table[:, 2:]
+    seen = np.zeros(len(out), bool)
+    seen[frame] = True
+    return _finish(path, [out[i] if seen[i] else None for i in range(len(out))],
+                   _fps_comment(path, head))
+
+
+def _numbered_lines(text: str) -> Iterator[tuple[int, str]]:
+    """``(line number from 1, line)`` of ``text``, one at a time (no copy of the text)."""
+    start, number = 0, 1
+    while start < len(text):
+        end = text.find("\n", start)
+        end = len(text) if end < 0 else end
+        yield number, text[start:end]
+        start, number = end + 1, number + 1
+
+
+def _raise_bad_row(path: Path, header_line: int, cols: list[int]) -> NoReturn:
+    """TrackingError naming the first row after the header whose columns ``cols``
+    (frame, point, x, y[, z]) are not a frame and point >= 0 and numbers."""
+    rows = ((i, ln) for i, ln in _numbered_lines(path.read_text(encoding="utf-8-sig"))
+            if i > header_line and ln.strip() and not ln.lstrip().startswith("#"))
+    for line, text in rows:
+        cells = next(csv.reader([text]))
         try:
-            frame, point = int(cells[cols[0]]), int(cells[cols[1]])
-            xyz = [float(cells[c]) for c in cols[2:]]
+            frame, point = (int(cells[c]) for c in cols[:2])
+            [float(cells[c]) for c in cols[2:]]
         except (ValueError, IndexError):
             raise TrackingError(f"bad landmark row {cells}", path=path, line=line) from None
         if frame < 0 or point < 0:
             raise TrackingError("frame and point must be >= 0", path=path, line=line)
-        table.setdefault(frame, {})[point] = xyz
-    if all(0 not in pts for pts in table.values()):  # numbered from 1, as iBUG's figure
-        table = {f: {p - 1: xyz for p, xyz in pts.items()} for f, pts in table.items()}
-    n_points = 1 + max(p for pts in table.values() for p in pts)
-    frames: list[np.ndarray | None] = []
-    for frame in range(1 + max(table)):
-        pts = table.get(frame)
-        if pts is None:
-            frames.append(None)
-            continue
-        arr = np.full((n_points, dim), np.nan)
-        for p, xyz in pts.items():
-            arr[p] = xyz
-        frames.append(arr)
-    return _finish(path, frames, _fps_comment(path, text))
+    raise TrackingError("unreadable landmark table", path=path)
 
 
 def _read_openface(path: Path, text: str) -> LandmarkFile:
@@ -249,6 +273,10 @@ def _read_pts_folder(path: Path) -> LandmarkFile:
                           for i in range(first, max(order) + 1)], None)
 
 
+_HEAD = 1 << 16
+"""Characters read first: enough for a CSV's header and comments."""
+
+
 def read_landmarks(path: str | os.PathLike[str]) -> LandmarkFile:
     """Read a landmark track (formats in the module docstring)."""
     path = Path(path)
@@ -259,19 +287,22 @@ def read_landmarks(path: str | os.PathLike[str]) -> LandmarkFile:
     suffix = path.suffix.lower()
     if suffix == ".pts":
         return _finish(path, [_read_pts_file(path)], None)
+    if suffix not in (".json", ".csv"):
+        raise TrackingError("landmark files are .csv, .json, .pts or a folder of .pts",
+                            path=path)
     try:
-        text = path.read_text(encoding="utf-8-sig")  # as Excel writes it, with a BOM
+        with path.open(encoding="utf-8-sig") as stream:  # as Excel writes it, with a BOM
+            head = stream.read(_HEAD)
+            first = next((ln for ln in head.splitlines()
+                          if ln.strip() and not ln.startswith("#")), "")
+            names = {h.strip().lower() for h in first.split(",")}
+            if suffix == ".csv" and {"frame", "point", "x", "y"} <= names:
+                return _read_long_csv(path, head)  # numpy reads the rows from the file
+            text = head + stream.read()
     except (OSError, UnicodeDecodeError) as exc:
         raise TrackingError(f"cannot read it: {exc}", path=path) from exc
     if suffix == ".json":
         return _read_json(path, text)
-    if suffix != ".csv":
-        raise TrackingError("landmark files are .csv, .json, .pts or a folder of .pts",
-                            path=path)
-    first = next((ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")), "")
-    names = {h.strip().lower() for h in first.split(",")}
-    if {"frame", "point", "x", "y"} <= names:
-        return _read_long_csv(path, text)
     if "x_0" in names and "y_0" in names:
         return _read_openface(path, text)
     raise TrackingError("CSV header is neither 'frame,point,x,y[,z]' nor OpenFace's",
