@@ -128,8 +128,10 @@ def _read_long_csv(path: Path, head: str) -> LandmarkFile:
     dim = 3 if "z" in header else 2
     cols = [header.index(c) for c in ("frame", "point", "x", "y", "z")[: 2 + dim]]
     try:
-        table = np.loadtxt(path, delimiter=",", comments="#", ndmin=2, skiprows=at,
-                           usecols=cols, encoding="utf-8-sig")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # no rows: said below
+            table = np.loadtxt(path, delimiter=",", comments="#", ndmin=2, skiprows=at,
+                               usecols=cols, encoding="utf-8-sig")
     except ValueError:
         _raise_bad_row(path, at, cols)
     if not len(table):
