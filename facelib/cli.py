@@ -642,11 +642,11 @@ def _track_source(args: argparse.Namespace, console: Console) -> _Tracked:
         file = read_landmarks(source)
         fps = file.fps if args.fps is None else args.fps
         layout = args.layout or file.layout
-        missing = [f"--{name} ({why})" for name, value, why in (
-            ("fps", fps, "the file does not say its frame rate"),
-            ("layout", layout, f"no packaged layout has {file.landmarks.shape[1]} points"))
-            if value is None]
         if fps is None or layout is None:
+            missing = [f"--{name} ({why})" for name, value, why in (
+                ("fps", fps, "the file does not say its frame rate"),
+                ("layout", layout, f"no packaged layout has {file.landmarks.shape[1]} points"))
+                if value is None]
             raise FacelibError(f"{source}: give " + " and ".join(missing))
         return _Tracked(file.landmarks, fps, layout, _neutral(args))
     from facelib.tracking.video import track_video, video_brows
@@ -670,6 +670,7 @@ def _track_camera(args: argparse.Namespace, console: Console) -> _Tracked:
     """``facelib track --camera``: record live; the neutral span the live run used."""
     import numpy as np
 
+    from facelib.tracking.headframe import face_found
     from facelib.tracking.live import run_camera
 
     camera = int(args.camera) if args.camera.isdigit() else args.camera
@@ -679,7 +680,7 @@ def _track_camera(args: argparse.Namespace, console: Console) -> _Tracked:
     recording = run_camera(camera, face=_face(args.face) if args.face else None,
                            neutral_frames=args.neutral_frames, window=not args.no_window,
                            max_frames=args.max_frames)
-    faces = np.flatnonzero(np.isfinite(recording.landmarks).all(axis=(1, 2)))
+    faces = np.flatnonzero(face_found(recording.landmarks))
     if len(faces) < args.neutral_frames:
         raise FacelibError(f"{camera!r}: a face in {len(faces)} of {len(recording.landmarks)} "
                            f"frames, fewer than the {args.neutral_frames} neutral frames")

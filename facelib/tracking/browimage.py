@@ -30,6 +30,8 @@ from facelib.errors import DataError, TrackingError
 from facelib.mpeg4 import FAPU_SCALE
 from facelib.tracking.headframe import (
     Neutral,
+    face_found,
+    face_frame,
     fill_gaps,
     neutral_face,
     neutral_frames,
@@ -113,7 +115,7 @@ def sampling_poses(landmarks: np.ndarray, neutral: Neutral, model: ObservationMo
     rotation = level.T @ rotation_matrices(angles[:, 0], angles[:, 1], angles[:, 2]) @ level
     nose = list(_settings().nose)
     turned = np.einsum("nij,sj->nsi", rotation, neutral.image_rest[nose])[..., :2]  # (n, s, 2)
-    seen = np.asarray(landmarks, np.float64)[:, nose, :2] * [1.0, -1.0]  # face frame x, y
+    seen = face_frame(landmarks[:, nose])[..., :2]
     n, s = turned.shape[:2]
     design = np.zeros((n, s, 2, 3))
     design[..., 0] = turned
@@ -211,7 +213,7 @@ def brow_features(images: Iterable[np.ndarray], landmarks: np.ndarray, patches: 
     (NaN rows: no face; NaN features there). TrackingError unless there is one image per
     landmark frame."""
     data = np.asarray(landmarks, np.float64)
-    found = np.asarray(np.isfinite(data).reshape(len(data), -1).all(axis=1))
+    found = face_found(data)
     out = np.full((len(data), N_FEATURES), np.nan)
     count = 0
     for i, image in enumerate(images):
@@ -221,8 +223,8 @@ def brow_features(images: Iterable[np.ndarray], landmarks: np.ndarray, patches: 
         if i % _CHUNK_FRAMES == 0:  # the poses of the next chunk of frames
             chunk = data[i:i + _CHUNK_FRAMES]
             faces = found[i:i + _CHUNK_FRAMES, None, None]
-            pose = sampling_poses(np.where(faces, chunk, neutral.image_rest * [1, -1, -1]),
-                                  neutral, model)
+            pose = sampling_poses(np.where(faces, chunk, face_frame(neutral.image_rest)),
+                                  neutral, model)  # face_frame is its own inverse
         if found[i]:
             out[i] = _register(_grey(image), patches, pose, i % _CHUNK_FRAMES)
     if count != len(data):

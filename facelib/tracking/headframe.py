@@ -23,8 +23,8 @@ from facelib.tracking.layouts import LandmarkLayout
 from facelib.tracking.pose import HeadPose, fit_pose, refine_pose_2d, unpose, unpose_2d
 from facelib.tracking.userfapu import complete_points, user_fapu
 
-__all__ = ["HeadFrame", "Neutral", "face_frame", "fill_gaps", "frame_spans", "head_frame",
-           "neutral_face", "neutral_frames", "neutral_span", "to_head_frame"]
+__all__ = ["HeadFrame", "Neutral", "face_found", "face_frame", "fill_gaps", "frame_spans",
+           "head_frame", "neutral_face", "neutral_frames", "neutral_span", "to_head_frame"]
 
 
 @dataclass(frozen=True)
@@ -77,6 +77,12 @@ def frame_spans(frames: np.ndarray) -> str:
     return ", ".join(parts)
 
 
+def face_found(landmarks: np.ndarray) -> np.ndarray:
+    """``(n,) bool`` the frames of ``(n, K, D)`` landmarks that hold a face (no NaN)."""
+    data = np.asarray(landmarks)
+    return np.asarray(np.isfinite(data).reshape(len(data), -1).all(axis=1))
+
+
 def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
     """Interpolate frames whose landmarks hold NaN (no face) linearly in time.
 
@@ -85,7 +91,7 @@ def fill_gaps(landmarks: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
     face. TrackingError if no frame has a face.
     """
     data = np.asarray(landmarks, np.float64)
-    lost = ~np.isfinite(data).reshape(len(data), -1).all(axis=1)
+    lost = ~face_found(data)
     if not lost.any():
         return data, ()
     data = data.copy()

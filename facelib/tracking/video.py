@@ -25,6 +25,7 @@ from facelib.checks import check_count
 from facelib.errors import MissingExtraError, TrackingError, TrackingWarning
 from facelib.tracking.browimage import track_brows
 from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
+from facelib.tracking.headframe import face_found
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.observation import ObservationModel, default_observation
 
@@ -74,7 +75,7 @@ class VideoTrack:
 
     @property
     def _found(self) -> np.ndarray:
-        return np.asarray(np.isfinite(self.landmarks).all(axis=(1, 2)))
+        return face_found(self.landmarks)
 
     @property
     def first_lit_face(self) -> int:
