@@ -14,7 +14,8 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
 2. The default head is rendered with them at 640x480 (framed as a webcam sees a head) and
    tracked with MediaPipe in video mode; landmarks and truth are cached in
    ``out/tracking_observation_training_SEED[_pPUSH].npz`` (re-used unless ``--fresh``).
-3. :func:`facelib.tracking.observation.learn_observation` fits the observation model and
+3. :func:`facelib.tracking.observation.learn_observation` fits the observation model (the
+   gaze from the eyes and the face's outline alone, ``model.json``'s ``gaze_region``) and
    it is written to ``facelib/data/tracking/observation_mediapipe.npz`` (the FAP estimator
    and the rigid pose fit's learned error); the closed-lips
    threshold and open lips' gain of :mod:`facelib.tracking.lipclosure` are learned from the
@@ -68,6 +69,7 @@ from facelib.tracking.lipclosure import (
 from facelib.tracking.observation import (
     MODEL_FAPS,
     ObservationModel,
+    gaze_region,
     learn_observation,
     save_observation,
 )
@@ -351,7 +353,8 @@ def main() -> None:
     lost = ~(np.isfinite(landmarks).all(axis=(1, 2)) & np.isfinite(brows).all(axis=1))
     print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL),
-                              components=args.components, brows=brows[~lost])
+                              components=args.components, brows=brows[~lost],
+                              regions=(gaze_region(),))
     if not args.no_write:
         write_lip_rule(tracks, streams)
         lip_closure.cache_clear()  # the validation reads the rule just written

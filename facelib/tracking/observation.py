@@ -41,6 +41,7 @@ import numpy as np
 
 from facelib.atomic import atomic_path
 from facelib.checks import check_count
+from facelib.data import json_data
 from facelib.data import path as data_path
 from facelib.errors import DataError, ParameterError, TrackingError
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, fap_table
@@ -48,9 +49,9 @@ from facelib.tracking.headframe import HeadFrame, head_frame, neutral_span
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.pose import HEAD_FAP_IDS, euler_angles
 
-__all__ = ["IMAGE_FAPS", "MODEL_FAPS", "ObservationModel", "default_observation", "fap_lengths",
-           "head_angles", "image_inputs", "learn_observation", "load_observation",
-           "pose_correction", "save_observation", "solve_observation"]
+__all__ = ["IMAGE_FAPS", "MODEL_FAPS", "LandmarkRegion", "ObservationModel", "default_observation",
+           "fap_lengths", "gaze_region", "head_angles", "image_inputs", "learn_observation",
+           "load_observation", "pose_correction", "save_observation", "solve_observation"]
 
 IMAGE_FAPS = (31, 32, 33, 34, 35, 36, 37, 38)
 """FAPs the packaged model also reads off the brows' image shifts: the brows' raise and
@@ -61,6 +62,27 @@ MODEL_FAPS = (3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 16, 17, 19, 20, 21, 22, 23, 2
 """FAPs the packaged model learns: what facelib's visemes, expressions, lids and gaze move
 on the skin and eyes (tongue, head and ears are left out)."""
 _DATA = "tracking/observation_mediapipe.npz"
+
+
+@dataclass(frozen=True)
+class LandmarkRegion:
+    """Some FAPs learned from some landmarks only (see :func:`learn_observation`).
+
+    faps: FAP ids (among the model's); landmarks: landmark rows they are read from;
+    components: principal components of those landmarks' motion the regression uses.
+    """
+
+    faps: tuple[int, ...]
+    landmarks: tuple[int, ...]
+    components: int
+
+
+def gaze_region() -> LandmarkRegion:
+    """The packaged model's gaze FAPs 23-26 and the MediaPipe landmarks they are learned
+    from (``model.json``, ``gaze_region``): the eye contours, the irises and the face's
+    outline."""
+    raw = json_data("tracking/model.json")["gaze_region"]
+    return LandmarkRegion(tuple(raw["faps"]), tuple(raw["landmarks"]), int(raw["components"]))
 
 
 @dataclass(frozen=True)
@@ -167,7 +189,8 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                       neutral: int | tuple[int, int] = 0,
                       faps: tuple[int, ...] = MODEL_FAPS,
                       components: int = 60, brows: np.ndarray | None = None,
-                      image_faps: tuple[int, ...] = IMAGE_FAPS) -> ObservationModel:
+                      image_faps: tuple[int, ...] = IMAGE_FAPS,
+                      regions: tuple[LandmarkRegion, ...] = ()) -> ObservationModel:
     """Learn the model from ``(n, 478, 3)`` MediaPipe landmarks (image coordinates, no
     missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
 
@@ -175,9 +198,12 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     motion the regression uses (fewer than frames); ``faps``: the distinct FAP ids (1-84) to
     learn; ``brows``: ``(n, 4)`` the frames' brow image shifts
     (:func:`~facelib.tracking.browimage.brow_features`), from which the ``image_faps``
-    (some of ``faps``) are learned a second time, with them. ParameterError when ``values``
-    is not one row of 84 FAPs per landmark frame, or ``brows`` not 4 finite numbers per
-    frame.
+    (some of ``faps``) are learned a second time, with them; ``regions``: FAPs learned from
+    some landmarks alone (:class:`LandmarkRegion`; their estimator is 0 elsewhere), so that
+    the motion of the rest of the face, which comes with them on the training head, is not
+    read as them on another face. ParameterError when ``values`` is not one row of 84 FAPs
+    per landmark frame, ``brows`` not 4 finite numbers per frame, or a region's FAPs not
+    among ``faps``.
     """
     known = np.asarray(values, np.float64)
     if known.shape != (len(landmarks), N_FAPS):
@@ -204,6 +230,8 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     scores = (flat - centre) @ basis.T
     coef = _least_squares(scores, np.hstack([target, pose_error]))
     estimator = (basis.T @ coef).reshape(n_land, 2, len(ids) + 3)
+    for region in regions:
+        _learn_region(estimator, moved, target, ids, region)
     model = ObservationModel(ids, estimator[..., :-3], _range(truth), estimator[..., -3:],
                              _range(pose_error))
     if brows is None:
@@ -220,6 +248,26 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
         model, image_faps=chosen,
         image_estimator=(basis.T @ coef[:components]).reshape(n_land, 2, len(chosen)),
         image_weights=coef[components:])
+
+
+def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
+                  ids: np.ndarray, region: LandmarkRegion) -> None:
+    """Overwrite ``estimator``'s ``(L, 2, m + 3)`` columns of ``region``'s FAPs with a
+    regression on the leading principal components of the ``(n, L, 2)`` motion of its
+    landmarks alone, for the ``(n, m)`` ``target``."""
+    wanted = _check_ids(region.faps, "region faps")
+    if not set(wanted.tolist()) <= set(ids.tolist()):
+        raise ParameterError(f"region FAPs {region.faps!r} must be among faps")
+    columns = [int(np.flatnonzero(ids == f)[0]) for f in wanted]
+    rows = np.asarray(region.landmarks, np.int64)
+    flat = moved[:, rows].reshape(len(moved), -1)
+    centre = flat.mean(axis=0)
+    basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:region.components]
+    coef = _least_squares((flat - centre) @ basis.T, target[:, columns])
+    estimator[..., columns] = 0.0
+    block = (basis.T @ coef).reshape(len(rows), 2, len(columns))
+    for k, column in enumerate(columns):
+        estimator[rows, :, column] = block[..., k]
 
 
 def _least_squares(design: np.ndarray, target: np.ndarray) -> np.ndarray:

@@ -16,7 +16,9 @@ from facelib.tracking.embedding import default_head_embedding
 from facelib.tracking.faps import measure_faps
 from facelib.tracking.observation import (
     MODEL_FAPS,
+    LandmarkRegion,
     default_observation,
+    gaze_region,
     learn_observation,
     load_observation,
     pose_correction,
@@ -116,6 +118,34 @@ def test_packaged_model():
     assert model.pose is not None and model.pose.shape == (478, 2, 3)
     assert model.pose_bounds is not None
     assert (np.abs(model.pose_bounds) < np.radians(20)).all()   # corrections of a few degrees
+
+
+def test_a_region_reads_its_faps_from_its_landmarks_alone(learned):
+    values = random_stream(400, seed=1)
+    region = LandmarkRegion((23, 24), gaze_region().landmarks, 30)   # the eyes and outline
+    model = learn_observation(camera(values), values, neutral=(0, 4), faps=FAPS,
+                              components=40, regions=(region,))
+    gaze = [FAPS.index(f) for f in (23, 24)]
+    elsewhere = np.setdiff1d(np.arange(478), region.landmarks)
+    assert not model.estimator[elsewhere][..., gaze].any()
+    assert np.abs(model.estimator[list(region.landmarks)][..., gaze]).max() > 0
+    others = [i for i in range(len(FAPS)) if i not in gaze]   # the rest as learned before
+    np.testing.assert_allclose(model.estimator[..., others], learned.estimator[..., others])
+    fresh = random_stream(120, seed=2)
+    found = measure_faps(camera(fresh), fps=25, neutral=(0, 4), rig=model, smooth=False,
+                         relations=False, close_lips=False).stream.values
+    for fap_id in (23, 24):
+        assert np.corrcoef(fresh[4:, fap_id - 1], found[4:, fap_id - 1])[0, 1] > 0.97
+    with pytest.raises(ParameterError, match=r"region FAPs \(25,\) must be among faps"):
+        learn_observation(camera(values), values, neutral=(0, 4), faps=FAPS, components=40,
+                          regions=(LandmarkRegion((25,), (468, 473), 2),))
+
+
+def test_packaged_gaze_reads_no_expression_landmarks():
+    model, region = default_observation(), gaze_region()
+    gaze = [MODEL_FAPS.index(f) for f in region.faps]
+    elsewhere = np.setdiff1d(np.arange(478), region.landmarks)
+    assert not model.estimator[elsewhere][..., gaze].any()   # lips and brows: nothing
 
 
 def test_pose_correction_learns_a_fit_error():
