@@ -153,22 +153,57 @@ def long_tracks(landmarks: np.ndarray, fps: float, minutes: Sequence[float] = (4
         print(f"  {length:g}-minute track ({n} frames, landmarks {track.nbytes / 1e6:.0f} MB): "
               f"landmarks to FAPs {n / took:.0f} frames/s, {peak / 1e6:.0f} MB allocated at "
               "the peak beyond the landmarks")
-    landmark_csv(np.resize(landmarks, (round(minutes[0] * 60 * fps), *landmarks.shape[1:])),
-                 fps, minutes[0])
+    track = np.resize(landmarks, (round(minutes[0] * 60 * fps), *landmarks.shape[1:]))
+    landmark_csv(track, fps, minutes[0])
+    openface_csv(track[:, :68, :2], fps, minutes[0])
 
 
-def landmark_csv(track: np.ndarray, fps: float, minutes: float) -> None:
-    """``--landmarks-out``'s CSV of ``track`` read back: time and peak memory."""
+def openface_csv(points: np.ndarray, fps: float, minutes: float) -> None:
+    """An OpenFace 2.x CSV as wide as FeatureExtraction writes one (714 columns: 68 points'
+    ``x_i, y_i`` among gaze, eye landmarks, 3-D points, shape parameters and action units,
+    here filler) of ``points`` ``(n, 68, 2)`` read: time and peak memory."""
+    n = len(points)
+    before, after = 294, 279  # OpenFace 2.2: x_0 is column 300 of 714
+    names = (["frame", "face_id", "timestamp", "confidence", "success"]
+             + [f"c{i}" for i in range(before)] + [f"x_{i}" for i in range(68)]
+             + [f"y_{i}" for i in range(68)] + [f"d{i}" for i in range(after)])
+    table = np.zeros((n, len(names)))
+    table[:, 0], table[:, 2], table[:, 3:5] = np.arange(1, n + 1), np.arange(n) / fps, 1.0
+    table[:, 5 + before:5 + before + 136] = points.transpose(0, 2, 1).reshape(n, 136)
     with tempfile.TemporaryDirectory() as folder:
-        path = write_landmarks_csv(Path(folder) / "track.csv", track, fps=fps)
+        path = Path(folder) / "openface.csv"
+        np.savetxt(path, table, fmt="%.3f", delimiter=", ", header=", ".join(names),
+                   comments="")
         tracemalloc.start()
         started = time.perf_counter()
         read_landmarks(path)
         took = time.perf_counter() - started
         peak = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
+        print(f"  an OpenFace CSV of as many frames ({path.stat().st_size / 1e6:.0f} MB, "
+              f"{len(names)} columns) read in {took:.1f} s, {peak / 1e6:.0f} MB allocated at "
+              "the peak")
+
+
+def landmark_csv(track: np.ndarray, fps: float, minutes: float) -> None:
+    """``--landmarks-out``'s CSV of ``track`` written and read back: time and peak memory
+    (the time without tracemalloc, which slows the writer's many small strings)."""
+    with tempfile.TemporaryDirectory() as folder:
+        started = time.perf_counter()
+        path = write_landmarks_csv(Path(folder) / "track.csv", track, fps=fps)
+        wrote = time.perf_counter() - started
+        tracemalloc.start()
+        write_landmarks_csv(path, track, fps=fps)
+        write_peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.reset_peak()
+        started = time.perf_counter()
+        read_landmarks(path)
+        took = time.perf_counter() - started
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
         print(f"  its landmark CSV ({minutes:g} minutes, {path.stat().st_size / 1e6:.0f} MB) "
-              f"read in {took:.1f} s, {peak / 1e6:.0f} MB allocated at the peak")
+              f"written in {wrote:.1f} s, {write_peak / 1e6:.0f} MB allocated at the peak; "
+              f"read in {took:.1f} s, {peak / 1e6:.0f} MB at the peak")
 
 
 def main() -> None:

@@ -27,7 +27,6 @@ frame is a TrackingError naming the file and line.
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import re
@@ -39,7 +38,7 @@ from typing import NoReturn
 
 import numpy as np
 
-from facelib.atomic import write_text_atomic
+from facelib.atomic import atomic_path
 from facelib.checks import check_fps
 from facelib.errors import ParameterError, TrackingError, TrackingWarning
 from facelib.tracking.faps import frame_spans
@@ -66,32 +65,45 @@ class LandmarkFile:
     layout: str | None
 
 
+_WRITE_FRAMES = 256
+"""Frames formatted at a time by :func:`write_landmarks_csv`."""
+
+
 def guess_layout(n_points: int) -> str | None:
     """``"ibug68"`` for 68 points, ``"mediapipe"`` for 468 or 478, else None."""
     return {68: "ibug68", 468: "mediapipe", 478: "mediapipe"}.get(n_points)
 
 
 def _finish(path: Path, frames: list[np.ndarray | None], fps: float | None) -> LandmarkFile:
+    """The track of ``frames`` (None: lost), each ``(K, D)``; see :func:`_checked`."""
     sizes = [f.shape for f in frames if f is not None]
     if not sizes:
         raise TrackingError("no frame with landmarks", path=path)
     shape = max(set(sizes), key=sizes.count)
-    bad = [i for i, f in enumerate(frames) if f is None or f.shape != shape
-           or not np.isfinite(f).all()]
-    wrong = [i for i in bad if frames[i] is not None]
-    if wrong:
-        warnings.warn(TrackingWarning(
-            f"{path.name}: frames {frame_spans(np.array(wrong))} have missing points or not "
-            f"{shape[0]} points; treated as lost"), stacklevel=3)
     out = np.full((len(frames), *shape), np.nan)
     for i, f in enumerate(frames):
-        if i not in bad and f is not None:
-            out[i] = f
-    plane = out[..., :2][np.isfinite(out[..., :2])]
-    if plane.size and np.abs(plane).max() <= 1.5:
+        if f is not None and f.shape == shape:
+            out[i] = f  # another shape stays NaN: a frame with missing points, below
+    return _checked(path, out, np.array([f is not None for f in frames], bool), fps)
+
+
+def _checked(path: Path, out: np.ndarray, seen: np.ndarray, fps: float | None
+             ) -> LandmarkFile:
+    """The :class:`LandmarkFile` of ``out`` ``(n, K, D)``, in place: the ``seen`` frames
+    (the file has them) with a missing point are lost (named in a warning), and a track
+    whose coordinates are all within 0-1 is refused."""
+    wrong = np.flatnonzero(seen & ~np.isfinite(out).all(axis=(1, 2)))
+    if wrong.size:
+        warnings.warn(TrackingWarning(
+            f"{path.name}: frames {frame_spans(wrong)} have missing points or not "
+            f"{out.shape[1]} points; treated as lost"), stacklevel=3)
+        out[wrong] = np.nan
+    plane = out[..., :2]  # NaN-ignoring extremes, without a copy of the track
+    largest = max(np.fmax.reduce(plane, axis=None), -np.fmin.reduce(plane, axis=None))
+    if largest <= 1.5:
         raise TrackingError("every coordinate is within 0-1: these look normalised; give "
                             "image pixels (x times the width, y times the height)", path=path)
-    return LandmarkFile(path, out, fps, guess_layout(shape[0]))
+    return LandmarkFile(path, out, fps, guess_layout(out.shape[1]))
 
 
 _COMMON_RATES = (24000 / 1001, 24.0, 25.0, 30000 / 1001, 30.0, 48.0, 50.0, 60000 / 1001,
@@ -122,8 +134,7 @@ def _read_long_csv(path: Path, head: str) -> LandmarkFile:
     """A ``frame, point, x, y[, z]`` table from the file (``head``: its first lines, with
     the header and any ``# fps`` comment), parsed by numpy: a long recording's CSV holds
     millions of rows; a bad row is found again line by line to name it."""
-    at, first = next((i, ln) for i, ln in _numbered_lines(head)
-                     if ln.strip() and not ln.lstrip().startswith("#"))
+    at, first = _header(head)
     header = [h.strip().lower() for h in first.split(",")]
     dim = 3 if "z" in header else 2
     cols = [header.index(c) for c in ("frame", "point", "x", "y", "z")[: 2 + dim]]
@@ -144,10 +155,10 @@ def _read_long_csv(path: Path, head: str) -> LandmarkFile:
         point = point - 1
     out = np.full((frame.max() + 1, point.max() + 1, dim), np.nan)
     out[frame, point] = table[:, 2:]
+    del table
     seen = np.zeros(len(out), bool)
     seen[frame] = True
-    return _finish(path, [out[i] if seen[i] else None for i in range(len(out))],
-                   _fps_comment(path, head))
+    return _checked(path, out, seen, _fps_comment(path, head))
 
 
 def _numbered_lines(text: str) -> Iterator[tuple[int, str]]:
@@ -177,39 +188,73 @@ def _raise_bad_row(path: Path, header_line: int, cols: list[int]) -> NoReturn:
     raise TrackingError("unreadable landmark table", path=path)
 
 
-def _read_openface(path: Path, text: str) -> LandmarkFile:
-    reader = csv.reader(io.StringIO(text))
-    header = [h.strip() for h in next(reader)]
-    xs = sorted((int(h[2:]), i) for i, h in enumerate(header) if re.fullmatch(r"x_\d+", h))
-    ys = sorted((int(h[2:]), i) for i, h in enumerate(header) if re.fullmatch(r"y_\d+", h))
+def _header(head: str) -> tuple[int, str]:
+    """The line number (from 1) and text of the header: the first line of ``head`` that is
+    neither blank nor a comment."""
+    return next((i, ln) for i, ln in _numbered_lines(head)
+                if ln.strip() and not ln.lstrip().startswith("#"))
+
+
+def _read_openface(path: Path, head: str) -> LandmarkFile:
+    """An OpenFace 2.x CSV (``head``: its first lines, with the header), its columns read by
+    numpy from the file; row by row only to name a bad row (or skip a blank one)."""
+    at, first = _header(head)
+    header = [h.strip() for h in first.split(",")]
+    xs = [i for _, i in sorted((int(h[2:]), i) for i, h in enumerate(header)
+                               if re.fullmatch(r"x_\d+", h))]
+    ys = [i for _, i in sorted((int(h[2:]), i) for i, h in enumerate(header)
+                               if re.fullmatch(r"y_\d+", h))]
     if len(xs) != len(ys) or not xs:
-        raise TrackingError("OpenFace CSV without matching x_i / y_i columns", path=path, line=1)
-    col = {name: header.index(name) for name in ("frame", "timestamp", "success", "face_id")
-           if name in header}
-    rows: list[tuple[int, float, int, np.ndarray | None]] = []  # frame, time, face, points
-    for line, cells in enumerate(reader, start=2):
-        if not any(c.strip() for c in cells):
+        raise TrackingError("OpenFace CSV without matching x_i / y_i columns", path=path,
+                            line=at)
+    named = [n for n in ("frame", "timestamp", "success", "face_id") if n in header]
+    cols = [header.index(n) for n in named] + xs + ys
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # no rows: said below
+            table = np.loadtxt(path, delimiter=",", comments=None, ndmin=2, skiprows=at,
+                               usecols=cols, encoding="utf-8-sig")
+    except ValueError:
+        table = _openface_rows(path, at, cols)
+    if not len(table):
+        raise TrackingError("no landmark rows after the header", path=path)
+    if "face_id" in named:  # the first face id
+        table = table[table[:, named.index("face_id")] == table[:, named.index("face_id")].min()]
+    column = {n: table[:, k] for k, n in enumerate(named)}
+    frame = column["frame"].astype(np.int64) if "frame" in column else np.arange(len(table))
+    ok = column["success"] > 0 if "success" in column else np.ones(len(table), bool)
+    points = np.stack([table[:, len(named):len(named) + len(xs)],
+                       table[:, len(named) + len(xs):]], axis=2)
+    frames: list[np.ndarray | None] = [None] * (int(np.ptp(frame)) + 1)
+    for f, good, pts in zip(frame - frame.min(), ok, points, strict=True):
+        frames[f] = pts if good else None  # a repeated frame: its last row
+    return _finish(path, frames, _openface_rate(frame, column.get("timestamp")))
+
+
+def _openface_rows(path: Path, header_line: int, cols: list[int]) -> np.ndarray:
+    """``(rows, len(cols))`` the ``cols`` of every row after the header that is not blank;
+    TrackingError naming the first row that is not numbers there."""
+    rows = []
+    for line, text in _numbered_lines(path.read_text(encoding="utf-8-sig")):
+        cells = next(csv.reader([text]), [])
+        if line <= header_line or not any(c.strip() for c in cells):
             continue
         try:
-            ok = "success" not in col or float(cells[col["success"]]) > 0
-            pts = np.array([[float(cells[i]) for _, i in xs], [float(cells[i]) for _, i in ys]]).T
-            rows.append((int(float(cells[col["frame"]])) if "frame" in col else len(rows),
-                         float(cells[col["timestamp"]]) if "timestamp" in col else np.nan,
-                         int(float(cells[col["face_id"]])) if "face_id" in col else 0,
-                         pts if ok else None))
+            rows.append([float(cells[c]) for c in cols])
         except (ValueError, IndexError):
             raise TrackingError("bad OpenFace row", path=path, line=line) from None
-    if not rows:
-        raise TrackingError("no landmark rows after the header", path=path)
-    face = min(r[2] for r in rows)  # the first face id
-    kept = {r[0]: r for r in rows if r[2] == face}
-    first = min(kept)
-    frames = [kept[f][3] if f in kept else None for f in range(first, max(kept) + 1)]
-    times = np.array([kept[f][1] for f in sorted(kept)])
-    span = np.ptp(np.array(sorted(kept)))
-    fps = (_snapped(span / (times[-1] - times[0]))
-           if span and np.isfinite(times).all() and times[-1] > times[0] else None)
-    return _finish(path, frames, fps)
+    return np.array(rows, np.float64).reshape(-1, len(cols))
+
+
+def _openface_rate(frame: np.ndarray, times: np.ndarray | None) -> float | None:
+    """Frames a second from the ``(n,)`` frame numbers and their timestamps (seconds, None
+    without them) over the whole track, snapped to a common rate; None if they do not
+    give one."""
+    if times is None or not np.isfinite(times).all():
+        return None
+    order = np.argsort(frame, kind="stable")
+    span, took = frame[order[-1]] - frame[order[0]], times[order[-1]] - times[order[0]]
+    return _snapped(span / took) if span and took > 0 else None
 
 
 def _read_json(path: Path, text: str) -> LandmarkFile:
@@ -300,13 +345,13 @@ def read_landmarks(path: str | os.PathLike[str]) -> LandmarkFile:
             names = {h.strip().lower() for h in first.split(",")}
             if suffix == ".csv" and {"frame", "point", "x", "y"} <= names:
                 return _read_long_csv(path, head)  # numpy reads the rows from the file
+            if suffix == ".csv" and {"x_0", "y_0"} <= names:
+                return _read_openface(path, head)  # likewise
             text = head + stream.read()
     except (OSError, UnicodeDecodeError) as exc:
         raise TrackingError(f"cannot read it: {exc}", path=path) from exc
     if suffix == ".json":
         return _read_json(path, text)
-    if "x_0" in names and "y_0" in names:
-        return _read_openface(path, text)
     raise TrackingError("CSV header is neither 'frame,point,x,y[,z]' nor OpenFace's",
                         path=path, line=1)
 
@@ -314,22 +359,26 @@ def read_landmarks(path: str | os.PathLike[str]) -> LandmarkFile:
 def write_landmarks_csv(path: str | os.PathLike[str], landmarks: np.ndarray, *,
                         fps: float) -> Path:
     """Write ``(n_frames, K, 2 or 3)`` landmarks as ``frame,point,x,y[,z]`` (lost frames,
-    NaN, are left out) with a ``# fps:`` comment; atomically. Returns the path."""
-    data = np.asarray(landmarks, np.float64)
+    NaN, are left out) with a ``# fps:`` comment; atomically, a few hundred frames at a
+    time (a long recording's table is never held whole as text). Returns the path."""
+    data = np.asarray(landmarks)
     if data.ndim != 3 or data.shape[2] not in (2, 3):
         raise TrackingError(f"landmarks must be (n_frames, K, 2 or 3), got {data.shape}")
     rate = check_fps(fps)
-    axes = "x,y,z" if data.shape[2] == 3 else "x,y"
-    out = [f"# facelib landmarks, image pixels (column, row[, depth])\n# fps: {rate:g}\n",
-           f"frame,point,{axes}\n"]
-    k = data.shape[1]
-    points = np.arange(k)
-    for i, frame in enumerate(data):
-        if not np.isfinite(frame).all():
-            continue
-        block = np.column_stack([np.full(k, i), points, frame])
-        out.append("\n".join(
-            f"{int(r[0])},{int(r[1])}," + ",".join(f"{v:.3f}" for v in r[2:]) for r in block))
-        out.append("\n")
-    write_text_atomic(path, "".join(out))
+    n, k, dim = data.shape
+    axes = "x,y,z" if dim == 3 else "x,y"
+    row = "%d,%d," + ",".join(["%.3f"] * dim) + "\n"
+    points = np.broadcast_to(np.arange(k, dtype=np.float64)[:, None], (k, 1))
+    with atomic_path(path) as temp, temp.open("w", encoding="utf-8", newline="\n") as out:
+        out.write(f"# facelib landmarks, image pixels (column, row[, depth])\n# fps: {rate:g}\n"
+                  f"frame,point,{axes}\n")
+        for start in range(0, n, _WRITE_FRAMES):
+            chunk = np.asarray(data[start:start + _WRITE_FRAMES], np.float64)
+            frames = np.flatnonzero(np.isfinite(chunk).all(axis=(1, 2)))
+            table = np.concatenate([np.broadcast_to((start + frames)[:, None, None],
+                                                    (len(frames), k, 1)),
+                                    np.broadcast_to(points, (len(frames), k, 1)),
+                                    chunk[frames]], axis=2)
+            out.write("".join((row * k) % tuple(values)
+                              for values in table.reshape(len(frames), -1).tolist()))
     return Path(path)

@@ -68,6 +68,19 @@ def test_openface_csv(tmp_path):
     assert np.isnan(got.landmarks[2]).all()
 
 
+def test_openface_blank_and_bad_rows(tmp_path):
+    """A row of empty cells is skipped; a row that is not numbers is named by its line."""
+    lines = openface_lines(random_track(5), 30, {})
+    blank = ", ".join([""] * len(lines[0].split(",")))
+    (tmp_path / "blank.csv").write_text("\n".join([*lines[:3], blank, *lines[3:]]) + "\n")
+    assert len(read_landmarks(tmp_path / "blank.csv").landmarks) == 5
+    cells = lines[4].split(", ")
+    cells[10] = "n/a"
+    (tmp_path / "bad.csv").write_text("\n".join([*lines[:4], ", ".join(cells)]) + "\n")
+    with pytest.raises(TrackingError, match=r"bad.csv:5: bad OpenFace row"):
+        read_landmarks(tmp_path / "bad.csv")
+
+
 def test_json_lists_and_pts(tmp_path):
     data = random_track(3)
     frames = [data[0].tolist(), None, data[2].tolist()]
