@@ -42,9 +42,12 @@ from pathlib import Path
 import numpy as np
 
 from facelib.data import path as data_path
-from facelib.engine import default_face
+from facelib.engine import Face, default_face
+from facelib.engine.headmesh import head_mesh
+from facelib.engine.setup import setup_face
+from facelib.engine.tps import fit_tps
 from facelib.expressions import default_library
-from facelib.mpeg4 import ANGLE_UNIT, N_FAPS, FapStream, fap, fap_table
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap, fap_table
 from facelib.tracking.closedloop import (
     LIPS_TOUCH,
     bilabial_closures,
@@ -78,7 +81,7 @@ from facelib.visemes.timeline import bilabial_spans
 
 ROOT = Path(__file__).resolve().parent.parent
 CACHE = ROOT / "out" / "tracking_observation_training_{seed}.npz"
-VALIDATION_CACHE = ROOT / "out" / "tracking_observation_validation.npz"
+VALIDATION_CACHE = ROOT / "out" / "tracking_observation_validation{head}.npz"
 SENTENCES = (
     "Peter brought a big basket of apples to the market every morning.",
     "Maybe the blue boat will come back before the moon is up.",
@@ -121,6 +124,9 @@ VALIDATION_SEED = 7
 VALIDATION_FAPS = (3, 6, 7, 12, 13, 31, 32, 19, 20, 21, 22, 23, 24, 48, 49, 50)
 """The FAPs the validation prints: those of the closed loop's table (open_jaw, lip corners,
 inner brows, lids, eyeball yaw, head pitch, yaw and roll)."""
+WARPED_HEADS = (1, 2)
+"""Seeds of the heads warped from the default one (:func:`warped_head`) the validation stream
+is also rendered on: faces the model was not trained on."""
 NEUTRAL = 8
 FACE_STEP, HEAD_STEP = 3, 12
 EXTRA_FAPS = (18, 44, 45, 46, 63, 81, 82)
@@ -219,8 +225,58 @@ def speech_stream(seed: int) -> tuple[FapStream, list[tuple[float, float]]]:
     return with_neutral_lead(FapStream(FPS, values.astype(np.float32)), NEUTRAL), bilabial
 
 
-def render_and_track(stream: FapStream) -> tuple[np.ndarray, np.ndarray]:
-    """``(n, 478, 3)`` MediaPipe landmarks of the default head rendered with ``stream`` and
+def warped_head(seed: int) -> Face:
+    """The default head given another face: its feature points moved by seeded proportions
+    (mouth width 0.85-1.18 times, lip thickness 0.7-1.35, eye size 0.88-1.14; mouth, chin,
+    brow and nose heights, eye spacing, nose and face width; the depth of the mouth, its
+    corners, the nose tip, brows and eyes; shifts in ES0), the skin warped along by a
+    thin-plate spline that holds the back of the head, and set up with ``setup_face``."""
+    face = default_face()
+    rng = np.random.default_rng(seed)
+    es = face.fapu["ES"] * FAPU_SCALE
+    src = {k: face.vertices[i].astype(np.float64) for k, i in face.feature_points.items()
+           if k not in ("3.5", "3.6")}  # the pupils are on the eyeballs, carried along
+    dst = dict(src)
+
+    def move(ids: list[str], centre: np.ndarray, scale: tuple[float, float, float],
+             shift: tuple[float, float, float]) -> None:
+        for k in ids:
+            dst[k] = centre + (dst[k] - centre) * scale + np.multiply(shift, es)
+
+    def pick(*groups: str) -> list[str]:
+        return [k for k in src if k.split(".")[0] in groups]
+
+    spread = rng.uniform
+    shift = lambda most: rng.uniform(-most, most)  # noqa: E731
+    mouth = np.array([0.0, (src["8.3"][1] + src["8.4"][1]) / 2, 0.0])
+    lips = [k for k in pick("2", "8") if k not in ("2.1", "2.10")]  # 2.1, 2.10: the chin
+    move(lips, mouth, (spread(0.85, 1.18), spread(0.7, 1.35), 1.0),
+         (0.0, shift(0.06), shift(0.04)))
+    move(["2.4", "2.5", "8.3", "8.4"], mouth, (1, 1, 1), (0.0, 0.0, shift(0.07)))
+    move(["2.1", "2.10"], mouth, (1, 1, 1), (0.0, shift(0.1), 0.0))
+    size, apart, depth = spread(0.88, 1.14), shift(0.05), shift(0.05)
+    for side, sign in (("3.1 3.3", 1), ("3.2 3.4", -1)):
+        ids = side.split()
+        move(ids, np.mean([src[k] for k in ids], axis=0), (size, size, size),
+             (sign * apart, 0.0, depth))
+    move(pick("4"), np.zeros(3), (1, 1, 1), (0.0, shift(0.07), shift(0.07)))
+    move(pick("9"), np.zeros(3), (spread(0.88, 1.15), 1, 1), (0.0, shift(0.05), 0.0))
+    move(["9.3"], np.zeros(3), (1, 1, 1), (0.0, 0.0, shift(0.1)))
+    move(pick("5", "10"), np.zeros(3), (spread(0.93, 1.07), 1, 1), (0.0, 0.0, 0.0))
+    skin = face.parts["skin"].vertex_ids  # the first vertices of the mesh
+    verts = face.vertices[skin].astype(np.float64)
+    back = verts[np.linalg.norm(verts - src["9.3"], axis=1) > 0.13][::40]
+    keys = list(src)
+    warp = fit_tps(np.vstack([[src[k] for k in keys], back]),
+                   np.vstack([[dst[k] for k in keys], back]))
+    mesh = head_mesh(warp(verts), face.parts["skin"].triangles,
+                     colors=face.vertex_colors[skin])
+    return setup_face(mesh, landmarks={k: int(face.feature_points[k]) for k in keys
+                                       if face.feature_points[k] < len(skin)})
+
+
+def render_and_track(stream: FapStream, face: Face) -> tuple[np.ndarray, np.ndarray]:
+    """``(n, 478, 3)`` MediaPipe landmarks of ``face`` rendered with ``stream`` and
     ``(n, 4)`` the brows' image shifts (:mod:`facelib.tracking.browimage`, against the
     first ``NEUTRAL`` frames). The shifts are sampled through the packaged model's pose
     correction, the one being rebuilt: its pose part is learned from these same streams
@@ -231,7 +287,7 @@ def render_and_track(stream: FapStream) -> tuple[np.ndarray, np.ndarray]:
     from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
     from facelib.tracking.observation import default_observation
 
-    face, model = default_face(), default_observation()
+    model = default_observation()
     points = np.full((stream.n_frames, N_LANDMARKS, 3), np.nan)
     brows = np.full((stream.n_frames, N_FEATURES), np.nan)
     lead: list[np.ndarray] = []
@@ -257,16 +313,17 @@ def render_and_track(stream: FapStream) -> tuple[np.ndarray, np.ndarray]:
     return points, brows
 
 
-def cached_track(stream: FapStream, cache: Path, fresh: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Landmarks and brow image shifts of ``stream`` rendered and tracked, from ``cache``
-    when it holds them."""
+def cached_track(stream: FapStream, cache: Path, fresh: bool, face: Face | None = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Landmarks and brow image shifts of ``stream`` rendered on ``face`` (default: the
+    default head) and tracked, from ``cache`` when it holds them."""
     if cache.exists() and not fresh:
         with np.load(cache) as cached:
             if np.array_equal(cached["values"], stream.values) and "brows" in cached.files:
                 return (np.asarray(cached["landmarks"], np.float64),
                         np.asarray(cached["brows"], np.float64))
         raise SystemExit(f"{cache} was made with other options or without brows; pass --fresh")
-    landmarks, brows = render_and_track(stream)
+    landmarks, brows = render_and_track(stream, default_face() if face is None else face)
     cache.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(cache, landmarks=landmarks.astype(np.float32), values=stream.values,
                         brows=brows)
@@ -306,27 +363,32 @@ def write_lip_rule(tracks: list[np.ndarray], streams: list[FapStream]) -> None:
 
 
 def validate(model: ObservationModel, fresh: bool) -> None:
-    """Print how ``model`` recovers the validation stream (speech-like, head sweeps): the
-    correlation of each FAP of ``VALIDATION_FAPS``, the inner-lip gap and the p/b/m
-    closures."""
+    """Print how ``model`` recovers the validation stream (speech-like, head sweeps) on the
+    default head and on the ``WARPED_HEADS``: the correlation of each FAP of
+    ``VALIDATION_FAPS``, the inner-lip gap and the p/b/m closures."""
     stream, bilabial = speech_stream(VALIDATION_SEED)
-    landmarks, brows = cached_track(stream, VALIDATION_CACHE, fresh)
-    found = measure_faps(landmarks, fps=FPS, neutral=(0, NEUTRAL), rig=model,
-                         brows=brows).stream[NEUTRAL:]
     truth = stream[NEUTRAL:]
-    r = np.array([curve_correlation(truth.values[:, f - 1], found.values[:, f - 1])
-                  for f in VALIDATION_FAPS])
-    print("validation stream, correlation per FAP: "
-          + ", ".join(f"{f} {c:.3f}" for f, c in zip(VALIDATION_FAPS, r, strict=True)))
-    print(f"  mean correlation {r.mean():.3f}")
-    truth_gap, gap = lip_gap(default_face(), truth), lip_gap(default_face(), found)
-    print(f"  inner-lip gap: correlation {curve_correlation(truth_gap, gap):.3f}, gain "
-          f"{curve_gain(truth_gap, gap):.2f}")
-    for kind, closures in (("p/b/m closures", bilabial_closures(truth_gap, bilabial, FPS)),
-                           ("all brief lip contacts", lip_closures(truth_gap, FPS))):
-        parted = closure_recall(closures, gap, truth_gap=truth_gap) * len(closures)
-        print(f"  {kind}: {len(closures)}, touch and part again {parted:.0f}")
-    print(f"  false closures: {false_closures(truth_gap, gap)}")
+    heads = [("default head", "", default_face())]
+    heads += [(f"warped head {seed}", f"_warped{seed}", warped_head(seed))
+              for seed in WARPED_HEADS]
+    for name, suffix, face in heads:
+        cache = Path(str(VALIDATION_CACHE).format(head=suffix))
+        landmarks, brows = cached_track(stream, cache, fresh, face)
+        found = measure_faps(landmarks, fps=FPS, neutral=(0, NEUTRAL), rig=model,
+                             brows=brows).stream[NEUTRAL:]
+        r = np.array([curve_correlation(truth.values[:, f - 1], found.values[:, f - 1])
+                      for f in VALIDATION_FAPS])
+        print(f"validation stream on the {name}, correlation per FAP: "
+              + ", ".join(f"{f} {c:.3f}" for f, c in zip(VALIDATION_FAPS, r, strict=True)))
+        print(f"  mean correlation {r.mean():.3f}")
+        truth_gap, gap = lip_gap(face, truth), lip_gap(face, found)
+        print(f"  inner-lip gap: correlation {curve_correlation(truth_gap, gap):.3f}, gain "
+              f"{curve_gain(truth_gap, gap):.2f}")
+        for kind, closures in (("p/b/m closures", bilabial_closures(truth_gap, bilabial, FPS)),
+                               ("all brief lip contacts", lip_closures(truth_gap, FPS))):
+            parted = closure_recall(closures, gap, truth_gap=truth_gap) * len(closures)
+            print(f"  {kind}: {len(closures)}, touch and part again {parted:.0f}")
+        print(f"  false closures: {false_closures(truth_gap, gap)}")
 
 
 def main() -> None:
