@@ -22,11 +22,14 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
    random streams' frames and written into ``facelib/data/tracking/lip_closure.json``.
 4. With ``--validate``, the model is checked on a speech-like *validation* stream:
    storyboards made up here (the sentences below, random expressions and eye behaviours)
-   animated by facelib, with slow random head sweeps (1226 frames, cached in
-   ``out/tracking_observation_validation.npz``); the correlations of the recovered FAPs
-   and the p/b/m closures are printed. Training choices (``--push``, the component count)
-   are made on it, never on the closed-loop test streams. Nothing here shares anything
-   with ``examples/hello/hello.fdl`` or ``examples/tracking/expressive.fdl``.
+   animated by facelib, with slow random head sweeps (1226 frames), rendered on the default
+   head and on two heads warped from it (:func:`warped_head`: faces never trained on;
+   cached in ``out/tracking_observation_validation[_warpedSEED].npz``); the correlations of
+   the recovered FAPs and the p/b/m closures are printed. Training choices (``--push``, the
+   component count, the filter's cutoffs) are made on it, never on the closed-loop test
+   streams (the gaze region is the exception; see docs/performance-driven.md). Nothing
+   here shares anything with ``examples/hello/hello.fdl`` or
+   ``examples/tracking/expressive.fdl``.
    ``--no-write`` leaves the packaged files as they are (for comparing choices; the
    validation then uses the packaged lip rule).
 
@@ -246,8 +249,10 @@ def warped_head(seed: int) -> Face:
     def pick(*groups: str) -> list[str]:
         return [k for k in src if k.split(".")[0] in groups]
 
+    def shift(most: float) -> float:
+        return float(rng.uniform(-most, most))
+
     spread = rng.uniform
-    shift = lambda most: rng.uniform(-most, most)  # noqa: E731
     mouth = np.array([0.0, (src["8.3"][1] + src["8.4"][1]) / 2, 0.0])
     lips = [k for k in pick("2", "8") if k not in ("2.1", "2.10")]  # 2.1, 2.10: the chin
     move(lips, mouth, (spread(0.85, 1.18), spread(0.7, 1.35), 1.0),

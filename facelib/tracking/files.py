@@ -368,7 +368,7 @@ def write_landmarks_csv(path: str | os.PathLike[str], landmarks: np.ndarray, *,
     n, k, dim = data.shape
     axes = "x,y,z" if dim == 3 else "x,y"
     row = "%d,%d," + ",".join(["%.3f"] * dim) + "\n"
-    points = np.broadcast_to(np.arange(k, dtype=np.float64)[:, None], (k, 1))
+    points = np.arange(k, dtype=np.float64)[:, None]
     with atomic_path(path) as temp, temp.open("w", encoding="utf-8", newline="\n") as out:
         out.write(f"# facelib landmarks, image pixels (column, row[, depth])\n# fps: {rate:g}\n"
                   f"frame,point,{axes}\n")

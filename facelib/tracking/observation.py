@@ -20,6 +20,10 @@ carries the statistics of facelib's visemes and expressions (r = 0.88). Both sid
 measured on the tracker's own landmarks in the user's FAPU, so the model carries over to
 other faces.
 
+Some FAPs can be learned from some landmarks alone (:class:`LandmarkRegion`): the packaged
+model reads the gaze from the eyes and the face's outline only (:func:`gaze_region`), so that
+a raised brow or an open jaw is not read as a look on a face other than the training head.
+
 The same regression learns the rigid pose fit's error (true minus fitted pitch, yaw and
 roll): expressions move the fit's stable points (a smile lifts the nostrils, which the fit
 alone reads as a nod of several degrees); tracking adds the estimate to the fitted angles
@@ -265,9 +269,7 @@ def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
     basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:region.components]
     coef = _least_squares((flat - centre) @ basis.T, target[:, columns])
     estimator[..., columns] = 0.0
-    block = (basis.T @ coef).reshape(len(rows), 2, len(columns))
-    for k, column in enumerate(columns):
-        estimator[rows, :, column] = block[..., k]
+    estimator[np.ix_(rows, [0, 1], columns)] = (basis.T @ coef).reshape(len(rows), 2, -1)
 
 
 def _least_squares(design: np.ndarray, target: np.ndarray) -> np.ndarray:
