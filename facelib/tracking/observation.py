@@ -269,7 +269,8 @@ def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
     basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:region.components]
     coef = _least_squares((flat - centre) @ basis.T, target[:, columns])
     estimator[..., columns] = 0.0
-    estimator[np.ix_(rows, [0, 1], columns)] = (basis.T @ coef).reshape(len(rows), 2, -1)
+    estimator[np.ix_(rows, np.arange(2), np.asarray(columns))] = (
+        basis.T @ coef).reshape(len(rows), 2, -1)
 
 
 def _least_squares(design: np.ndarray, target: np.ndarray) -> np.ndarray:
