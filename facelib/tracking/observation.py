@@ -226,12 +226,8 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                              f"frames, got {n}")
     truth = known[:, ids - 1]
     target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
-    head = [f - 1 for f in HEAD_FAP_IDS]
-    pose_error = known[:, head] * ANGLE_UNIT - fitted
-    flat = moved.reshape(n, -1)
-    centre = flat.mean(axis=0)
-    basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:components]  # (k, 2L)
-    scores = (flat - centre) @ basis.T
+    pose_error = known[:, [f - 1 for f in HEAD_FAP_IDS]] * ANGLE_UNIT - fitted
+    basis, scores = _principal(moved.reshape(n, -1), components)
     coef = _least_squares(scores, np.hstack([target, pose_error]))
     estimator = (basis.T @ coef).reshape(n_land, 2, len(ids) + 3)
     for region in regions:
@@ -264,13 +260,19 @@ def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
         raise ParameterError(f"region FAPs {region.faps!r} must be among faps")
     columns = [int(np.flatnonzero(ids == f)[0]) for f in wanted]
     rows = np.asarray(region.landmarks, np.int64)
-    flat = moved[:, rows].reshape(len(moved), -1)
-    centre = flat.mean(axis=0)
-    basis = np.linalg.svd(flat - centre, full_matrices=False)[2][:region.components]
-    coef = _least_squares((flat - centre) @ basis.T, target[:, columns])
+    basis, scores = _principal(moved[:, rows].reshape(len(moved), -1), region.components)
+    coef = _least_squares(scores, target[:, columns])
     estimator[..., columns] = 0.0
     estimator[np.ix_(rows, np.arange(2), np.asarray(columns))] = (
         basis.T @ coef).reshape(len(rows), 2, -1)
+
+
+def _principal(rows: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` leading principal axes ``(k, d)`` of the ``(n, d)`` ``rows`` and the
+    rows' scores on them ``(n, k)``."""
+    centred = rows - rows.mean(axis=0)
+    basis = np.linalg.svd(centred, full_matrices=False)[2][:count]
+    return basis, centred @ basis.T
 
 
 def _least_squares(design: np.ndarray, target: np.ndarray) -> np.ndarray:
