@@ -39,6 +39,7 @@ Deterministic up to MediaPipe's and the renderer's own floating point.
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 from pathlib import Path
 
@@ -230,10 +231,11 @@ def speech_stream(seed: int) -> tuple[FapStream, list[tuple[float, float]]]:
 
 def warped_head(seed: int) -> Face:
     """The default head given another face: its feature points moved by seeded proportions
-    (mouth width 0.85-1.18 times, lip thickness 0.7-1.35, eye size 0.88-1.14; mouth, chin,
-    brow and nose heights, eye spacing, nose and face width; the depth of the mouth, its
-    corners, the nose tip, brows and eyes; shifts in ES0), the skin warped along by a
-    thin-plate spline that holds the back of the head, and set up with ``setup_face``."""
+    (mouth width 0.85-1.18 times, lip thickness 0.7-1.35, the lids' opening 0.88-1.14;
+    mouth, chin, brow and nose heights, the lids' spacing, nose and face width; the depth
+    of the mouth, its corners, the nose tip, brows and eyes; shifts in ES0), the skin warped
+    along by a thin-plate spline that holds the back of the head, and set up with
+    ``setup_face``."""
     face = default_face()
     rng = np.random.default_rng(seed)
     es = face.fapu["ES"] * FAPU_SCALE
@@ -321,17 +323,23 @@ def render_and_track(stream: FapStream, face: Face) -> tuple[np.ndarray, np.ndar
 def cached_track(stream: FapStream, cache: Path, fresh: bool, face: Face | None = None
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Landmarks and brow image shifts of ``stream`` rendered on ``face`` (default: the
-    default head) and tracked, from ``cache`` when it holds them."""
+    default head) and tracked, from ``cache`` when it holds them for the same stream and
+    head (a cache made before heads were recorded is taken as the default head's)."""
+    face = default_face() if face is None else face
+    head = hashlib.sha256(np.ascontiguousarray(face.vertices).tobytes()).hexdigest()
     if cache.exists() and not fresh:
         with np.load(cache) as cached:
-            if np.array_equal(cached["values"], stream.values) and "brows" in cached.files:
+            same_head = "head" not in cached.files or str(cached["head"]) == head
+            if (np.array_equal(cached["values"], stream.values) and "brows" in cached.files
+                    and same_head):
                 return (np.asarray(cached["landmarks"], np.float64),
                         np.asarray(cached["brows"], np.float64))
-        raise SystemExit(f"{cache} was made with other options or without brows; pass --fresh")
-    landmarks, brows = render_and_track(stream, default_face() if face is None else face)
+        raise SystemExit(f"{cache} was made with other options, another head or without "
+                         "brows; pass --fresh")
+    landmarks, brows = render_and_track(stream, face)
     cache.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(cache, landmarks=landmarks.astype(np.float32), values=stream.values,
-                        brows=brows)
+                        brows=brows, head=np.array(head))
     return landmarks, brows
 
 

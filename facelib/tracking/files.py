@@ -207,7 +207,7 @@ def _read_openface(path: Path, head: str) -> LandmarkFile:
     if len(xs) != len(ys) or not xs:
         raise TrackingError("OpenFace CSV without matching x_i / y_i columns", path=path,
                             line=at)
-    named = [n for n in ("frame", "timestamp", "success", "face_id") if n in header]
+    named: list[str] = [n for n in ("frame", "timestamp", "success", "face_id") if n in header]
     cols = [header.index(n) for n in named] + xs + ys
     try:
         with warnings.catch_warnings():
@@ -215,9 +215,11 @@ def _read_openface(path: Path, head: str) -> LandmarkFile:
             table = np.loadtxt(path, delimiter=",", comments=None, ndmin=2, skiprows=at,
                                usecols=cols, encoding="utf-8-sig")
     except ValueError:
-        table = _openface_rows(path, at, cols)
+        table = _openface_rows(path, at, cols, named)
     if not len(table):
         raise TrackingError("no landmark rows after the header", path=path)
+    if not _whole_numbers(table, named):
+        _openface_rows(path, at, cols, named)  # raises, naming the row
     if "face_id" in named:  # the first face id
         table = table[table[:, named.index("face_id")] == table[:, named.index("face_id")].min()]
     column = {n: table[:, k] for k, n in enumerate(named)}
@@ -231,18 +233,31 @@ def _read_openface(path: Path, head: str) -> LandmarkFile:
     return _finish(path, frames, _openface_rate(frame, column.get("timestamp")))
 
 
-def _openface_rows(path: Path, header_line: int, cols: list[int]) -> np.ndarray:
+def _whole_numbers(table: np.ndarray, named: list[str]) -> bool:
+    """Whether the ``frame`` and ``face_id`` columns of ``table`` (among its first
+    ``named``) are finite numbers that make exact integers."""
+    ids = [named.index(n) for n in ("frame", "face_id") if n in named]
+    return bool((np.abs(table[:, ids]) < 2.0**53).all())
+
+
+def _openface_rows(path: Path, header_line: int, cols: list[int], named: list[str]
+                   ) -> np.ndarray:
     """``(rows, len(cols))`` the ``cols`` of every row after the header that is not blank;
-    TrackingError naming the first row that is not numbers there."""
+    TrackingError naming the first row that is not numbers there, or whose frame or face id
+    (``named``: the names of the first columns) is not a whole number."""
     rows = []
     for line, text in _numbered_lines(path.read_text(encoding="utf-8-sig")):
         cells = next(csv.reader([text]), [])
         if line <= header_line or not any(c.strip() for c in cells):
             continue
         try:
-            rows.append([float(cells[c]) for c in cols])
+            row = [float(cells[c]) for c in cols]
         except (ValueError, IndexError):
             raise TrackingError("bad OpenFace row", path=path, line=line) from None
+        if not _whole_numbers(np.array([row]), named):
+            raise TrackingError("bad OpenFace row: its frame or face_id is not a whole number",
+                                path=path, line=line)
+        rows.append(row)
     return np.array(rows, np.float64).reshape(-1, len(cols))
 
 
@@ -252,8 +267,9 @@ def _openface_rate(frame: np.ndarray, times: np.ndarray | None) -> float | None:
     give one."""
     if times is None or not np.isfinite(times).all():
         return None
-    order = np.argsort(frame, kind="stable")
-    span, took = frame[order[-1]] - frame[order[0]], times[order[-1]] - times[order[0]]
+    order = np.argsort(frame, kind="stable")  # a repeated frame: its last row, as read
+    low = order[np.searchsorted(frame[order], frame[order[0]], side="right") - 1]
+    span, took = frame[order[-1]] - frame[low], times[order[-1]] - times[low]
     return _snapped(span / took) if span and took > 0 else None
 
 
@@ -375,6 +391,8 @@ def write_landmarks_csv(path: str | os.PathLike[str], landmarks: np.ndarray, *,
         for start in range(0, n, _WRITE_FRAMES):
             chunk = np.asarray(data[start:start + _WRITE_FRAMES], np.float64)
             frames = np.flatnonzero(np.isfinite(chunk).all(axis=(1, 2)))
+            if not len(frames):  # a stretch with no face
+                continue
             table = np.concatenate([np.broadcast_to((start + frames)[:, None, None],
                                                     (len(frames), k, 1)),
                                     np.broadcast_to(points, (len(frames), k, 1)),

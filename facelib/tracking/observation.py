@@ -72,8 +72,9 @@ _DATA = "tracking/observation_mediapipe.npz"
 class LandmarkRegion:
     """Some FAPs learned from some landmarks only (see :func:`learn_observation`).
 
-    faps: FAP ids (among the model's); landmarks: landmark rows they are read from;
-    components: principal components of those landmarks' motion the regression uses.
+    faps: FAP ids (among the model's); landmarks: distinct landmark rows they are read
+    from; components: principal components of those landmarks' motion the regression uses
+    (at most twice the landmarks, and fewer than the frames).
     """
 
     faps: tuple[int, ...]
@@ -260,6 +261,14 @@ def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
         raise ParameterError(f"region FAPs {region.faps!r} must be among faps")
     columns = [int(np.flatnonzero(ids == f)[0]) for f in wanted]
     rows = np.asarray(region.landmarks, np.int64)
+    if (rows.ndim != 1 or not rows.size or len(np.unique(rows)) != rows.size
+            or rows.min() < 0 or rows.max() >= moved.shape[1]):
+        raise ParameterError(f"region landmarks must be distinct rows in 0-{moved.shape[1] - 1}"
+                             f", got {region.landmarks!r}")
+    most = min(2 * rows.size, len(moved) - 2)
+    if not 1 <= check_count("region components", region.components, low=1) <= most:
+        raise ParameterError(f"region components must be 1-{most} for {rows.size} landmarks "
+                             f"and {len(moved)} frames, got {region.components}")
     basis, scores = _principal(moved[:, rows].reshape(len(moved), -1), region.components)
     coef = _least_squares(scores, target[:, columns])
     estimator[..., columns] = 0.0

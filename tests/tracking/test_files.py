@@ -29,6 +29,17 @@ def test_csv_round_trip_keeps_values_rate_and_lost_frames(tmp_path):
     np.testing.assert_allclose(back.landmarks, data, atol=1e-3, equal_nan=True)
 
 
+def test_csv_of_a_long_stretch_without_a_face(tmp_path):
+    """The writer formats a few hundred frames at a time: a whole batch of lost frames
+    (here 300, about 10 s) is left out, and a track with no face at all is a header."""
+    data = random_track(700, 68, 2)
+    data[200:500] = np.nan
+    back = read_landmarks(write_landmarks_csv(tmp_path / "gap.csv", data, fps=30))
+    np.testing.assert_allclose(back.landmarks, data, atol=1e-3, equal_nan=True)
+    empty = write_landmarks_csv(tmp_path / "none.csv", np.full((300, 68, 2), np.nan), fps=30)
+    assert empty.read_text().splitlines()[-1] == "frame,point,x,y"
+
+
 def test_generic_csv_with_a_missing_point_names_the_frame(tmp_path):
     rows = ["frame,point,x,y"] + [f"{f},{p},{100 + p},{200 + f}" for f in range(3)
                                   for p in range(68) if not (f == 1 and p == 30)]
@@ -79,6 +90,28 @@ def test_openface_blank_and_bad_rows(tmp_path):
     (tmp_path / "bad.csv").write_text("\n".join([*lines[:4], ", ".join(cells)]) + "\n")
     with pytest.raises(TrackingError, match=r"bad.csv:5: bad OpenFace row"):
         read_landmarks(tmp_path / "bad.csv")
+
+
+def test_openface_frames_and_faces_must_be_whole_numbers(tmp_path):
+    lines = openface_lines(random_track(4), 30, {})
+    for bad in ("nan", "inf", "1e20"):
+        cells = lines[3].split(", ")
+        cells[0] = bad
+        (tmp_path / "of.csv").write_text("\n".join([*lines[:3], ", ".join(cells), lines[4]]))
+        with pytest.raises(TrackingError, match=r"of.csv:4: bad OpenFace row: its frame"):
+            read_landmarks(tmp_path / "of.csv")
+
+
+def test_openface_repeated_frames_keep_their_last_row(tmp_path):
+    """A frame written twice counts once, by its last row, for the points and the rate."""
+    data = random_track(31)
+    lines = openface_lines(data, 30, {})
+    again = lines[1].split(", ")
+    again[2] = "0.100"  # frame 1 again, stamped as frame 4
+    (tmp_path / "of.csv").write_text("\n".join([lines[0], lines[1], ", ".join(again),
+                                                *lines[2:]]))
+    got = read_landmarks(tmp_path / "of.csv")
+    assert len(got.landmarks) == 31 and got.fps == pytest.approx(30 / 0.9)  # 30 frames in 0.9 s
 
 
 def test_json_lists_and_pts(tmp_path):

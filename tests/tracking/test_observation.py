@@ -136,9 +136,15 @@ def test_a_region_reads_its_faps_from_its_landmarks_alone(learned):
                          relations=False, close_lips=False).stream.values
     for fap_id in (23, 24):
         assert np.corrcoef(fresh[4:, fap_id - 1], found[4:, fap_id - 1])[0, 1] > 0.97
+    points = camera(values)
     with pytest.raises(ParameterError, match=r"region FAPs \(25,\) must be among faps"):
-        learn_observation(camera(values), values, neutral=(0, 4), faps=FAPS, components=40,
+        learn_observation(points, values, neutral=(0, 4), faps=FAPS, components=40,
                           regions=(LandmarkRegion((25,), (468, 473), 2),))
+    for landmarks, components in (((468, 468), 2), ((468, -1), 2), ((468, 478), 2),
+                                  ((468, 473), 5), ((468, 473), 0)):
+        with pytest.raises(ParameterError, match=r"region (landmarks|components)"):
+            learn_observation(points, values, neutral=(0, 4), faps=FAPS, components=40,
+                              regions=(LandmarkRegion((23,), landmarks, components),))
 
 
 def test_packaged_gaze_reads_no_expression_landmarks():
