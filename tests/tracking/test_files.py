@@ -102,6 +102,18 @@ def test_openface_frames_and_faces_must_be_whole_numbers(tmp_path):
             read_landmarks(tmp_path / "of.csv")
 
 
+def test_openface_without_a_frame_column_counts_the_first_face_rows(tmp_path):
+    """Without ``frame``, each row of the lowest face id is the next frame (the other
+    faces' rows in between are no frames of it)."""
+    data = random_track(60)
+    lines = openface_lines(data, 30, {f: [0, 1] for f in range(60)})
+    cut = [", ".join(line.split(", ")[1:]) for line in lines]  # drop the frame column
+    (tmp_path / "of.csv").write_text("\n".join(cut))
+    got = read_landmarks(tmp_path / "of.csv")
+    assert len(got.landmarks) == 60 and got.fps == 30
+    np.testing.assert_allclose(got.landmarks, data)
+
+
 def test_openface_repeated_frames_keep_their_last_row(tmp_path):
     """A frame written twice counts once, by its last row, for the points and the rate."""
     data = random_track(31)
