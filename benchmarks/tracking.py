@@ -32,7 +32,7 @@ from __future__ import annotations
 import tempfile
 import time
 import tracemalloc
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -138,18 +138,25 @@ def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
           f"path without decoding: {n / (track_s + brows_s + faps_s):.0f} frames/s")
 
 
+def traced(call: Callable[[], object]) -> tuple[float, int]:
+    """Seconds ``call()`` took and the bytes it allocated at the peak (tracemalloc, which
+    slows code that makes many small objects: time such code again without it)."""
+    tracemalloc.start()
+    started = time.perf_counter()
+    call()
+    took = time.perf_counter() - started
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return took, peak
+
+
 def long_tracks(landmarks: np.ndarray, fps: float, minutes: Sequence[float] = (4, 20)) -> None:
     """Landmarks to FAPs on ``landmarks`` repeated to tracks of ``minutes``: time and the
     peak memory it allocates beyond its input (both should grow linearly at most)."""
     for length in minutes:
         n = round(length * 60 * fps)
         track = np.resize(landmarks, (n, *landmarks.shape[1:]))
-        tracemalloc.start()
-        started = time.perf_counter()
-        measure_faps(track, fps=fps)
-        took = time.perf_counter() - started
-        peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
+        took, peak = traced(lambda: measure_faps(track, fps=fps))  # noqa: B023
         print(f"  {length:g}-minute track ({n} frames, landmarks {track.nbytes / 1e6:.0f} MB): "
               f"landmarks to FAPs {n / took:.0f} frames/s, {peak / 1e6:.0f} MB allocated at "
               "the peak beyond the landmarks")
@@ -174,12 +181,7 @@ def openface_csv(points: np.ndarray, fps: float, minutes: float) -> None:
         path = Path(folder) / "openface.csv"
         np.savetxt(path, table, fmt="%.3f", delimiter=", ", header=", ".join(names),
                    comments="")
-        tracemalloc.start()
-        started = time.perf_counter()
-        read_landmarks(path)
-        took = time.perf_counter() - started
-        peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
+        took, peak = traced(lambda: read_landmarks(path))
         print(f"  an OpenFace CSV of as many frames ({path.stat().st_size / 1e6:.0f} MB, "
               f"{len(names)} columns) read in {took:.1f} s, {peak / 1e6:.0f} MB allocated at "
               "the peak")
@@ -192,15 +194,8 @@ def landmark_csv(track: np.ndarray, fps: float, minutes: float) -> None:
         started = time.perf_counter()
         path = write_landmarks_csv(Path(folder) / "track.csv", track, fps=fps)
         wrote = time.perf_counter() - started
-        tracemalloc.start()
-        write_landmarks_csv(path, track, fps=fps)
-        write_peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.reset_peak()
-        started = time.perf_counter()
-        read_landmarks(path)
-        took = time.perf_counter() - started
-        peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
+        write_peak = traced(lambda: write_landmarks_csv(path, track, fps=fps))[1]
+        took, peak = traced(lambda: read_landmarks(path))
         print(f"  its landmark CSV ({minutes:g} minutes, {path.stat().st_size / 1e6:.0f} MB) "
               f"written in {wrote:.1f} s, {write_peak / 1e6:.0f} MB allocated at the peak; "
               f"read in {took:.1f} s, {peak / 1e6:.0f} MB at the peak")

@@ -171,13 +171,20 @@ def _numbered_lines(text: str) -> Iterator[tuple[int, str]]:
         start, number = end + 1, number + 1
 
 
+def _data_rows(path: Path, header_line: int, *, comments: bool
+               ) -> Iterator[tuple[int, list[str]]]:
+    """``(line number, cells)`` of each line of the file after the header that is not blank
+    (nor, with ``comments``, a ``#`` comment): the slow path that names a bad row."""
+    for line, text in _numbered_lines(path.read_text(encoding="utf-8-sig")):
+        if line > header_line and text.strip() and not (
+                comments and text.lstrip().startswith("#")):
+            yield line, next(csv.reader([text]))
+
+
 def _raise_bad_row(path: Path, header_line: int, cols: list[int]) -> NoReturn:
     """TrackingError naming the first row after the header whose columns ``cols``
     (frame, point, x, y[, z]) are not a frame and point >= 0 and numbers."""
-    rows = ((i, ln) for i, ln in _numbered_lines(path.read_text(encoding="utf-8-sig"))
-            if i > header_line and ln.strip() and not ln.lstrip().startswith("#"))
-    for line, text in rows:
-        cells = next(csv.reader([text]))
+    for line, cells in _data_rows(path, header_line, comments=True):
         try:
             frame, point = (int(cells[c]) for c in cols[:2])
             [float(cells[c]) for c in cols[2:]]
@@ -246,9 +253,8 @@ def _openface_rows(path: Path, header_line: int, cols: list[int], named: list[st
     TrackingError naming the first row that is not numbers there, or whose frame or face id
     (``named``: the names of the first columns) is not a whole number."""
     rows = []
-    for line, text in _numbered_lines(path.read_text(encoding="utf-8-sig")):
-        cells = next(csv.reader([text]), [])
-        if line <= header_line or not any(c.strip() for c in cells):
+    for line, cells in _data_rows(path, header_line, comments=False):
+        if not any(c.strip() for c in cells):  # a row of empty cells
             continue
         try:
             row = [float(cells[c]) for c in cols]
