@@ -601,7 +601,9 @@ def _add_track(commands: Any) -> None:
                        "first frame with a face; in a video, with a well-lit face)")
     track.add_argument("--pucker", action="append", metavar="START:STOP",
                        help="frames labelled pucker (eq. 4.17 high-level state); repeatable")
-    track.add_argument("--no-smooth", action="store_true", help="skip the One Euro filter")
+    track.add_argument("--no-smooth", action="store_true",
+                       help="skip the One Euro filter and the jaw drawn across brief lip "
+                       "closures")
     track.add_argument("--layout", choices=("mediapipe", "ibug68"),
                        help="landmark files: the point layout (default: by point count)")
     track.add_argument("--fps", type=float, help="landmark files: their frame rate")

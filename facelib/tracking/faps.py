@@ -20,9 +20,9 @@ The chain, each step a function over arrays:
 5. gaze 23-26 from the pupils' motion relative to the eye corners (eyeball radius from the
    eye width), head pitch/yaw/roll 48-50 from the fit (with the learned model, plus its
    estimate of the fit's error);
-6. One Euro smoothing (blinks and closures keep their depth), the closed mouth of p/b/m
-   (:mod:`~facelib.tracking.lipclosure`), then the FAP relationships of eq. 4.17 (and
-   high-level states such as pucker) fill untracked FAPs.
+6. One Euro smoothing (blinks and closures keep their depth) and the jaw drawn across brief
+   closures, the closed mouth of p/b/m (:mod:`~facelib.tracking.lipclosure`), then the FAP
+   relationships of eq. 4.17 (and high-level states such as pucker) fill untracked FAPs.
 """
 
 from __future__ import annotations
@@ -404,7 +404,9 @@ def measure_faps(
     neutral: the neutral frame, or a ``(start, stop)`` span averaged over its frames with a
         face; None: the first frame with a face. TrackingError when it has none.
     fapu: FAPU overrides in the landmarks' unit (e.g. ``{"MNS": 18.3 / 1024}``).
-    smooth: apply the One Euro filter.
+    smooth: apply the One Euro filter (both ways) and, with the mouth state, draw open_jaw
+        across brief closures (:func:`~facelib.tracking.lipclosure.bridge_jaw`): the
+        temporal steps that need the whole track.
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
     relations: fill untracked FAPs by eq. 4.17.
     rig: the model read off the landmark motion instead of eq. 4.16's one point per FAP:
@@ -431,10 +433,16 @@ def measure_faps(
     found = _join([measure_frames(data[cut], rest, layout=layout, model=model, lips=lips,
                                   brows=None if shifts is None else shifts[cut])
                    for cut in _chunks(len(data))])
-    values, mask = settle_faps(
-        _smooth(found.values, found.mask, rate) if smooth else found.values, found.mask,
-        states=states, relations=relations,
-        lips=None if found.aperture is None else (found.aperture, mouth_closed(found.aperture)))
+    lips_state = None if found.aperture is None else (found.aperture,
+                                                        mouth_closed(found.aperture))
+    values = found.values
+    if smooth:  # the recorded track's time: the filter both ways, the jaw across closures
+        values = _smooth(values, found.mask, rate)
+        if lips_state is not None:
+            longest = round(lipclosure.lip_closure().jaw_bridge_s * rate)
+            values = lipclosure.bridge_jaw(values, lips_state[1], longest=longest)
+    values, mask = settle_faps(values, found.mask, states=states, relations=relations,
+                               lips=lips_state)
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
 
 

@@ -25,7 +25,12 @@ closed state in those frames:
    alike, ``open_gain`` being the least-squares slope through 0 of the true separation on
    the aperture over the training renders' frames not in the closed state: the estimator
    and the smoothing shrink the quick openings between two closures ("a baby"), which
-   MediaPipe's inner-lip points still show.
+   MediaPipe's inner-lip points still show;
+5. on a recorded track (with the smoothing), open_jaw through a closure of at most
+   ``jaw_bridge_s`` seconds is drawn straight from the frame before it to the frame after
+   it (:func:`bridge_jaw`): with the lips sealed, the landmarks no longer show the jaw
+   (MediaPipe's chin follows it at half its motion), and a jaw that stays open for the
+   next vowel while the lips press would otherwise read as closed.
 """
 
 from __future__ import annotations
@@ -41,8 +46,9 @@ from facelib.errors import DataError, ParameterError
 from facelib.mpeg4 import FAPU_SCALE, fap
 from facelib.tracking.headframe import HeadFrame
 
-__all__ = ["LipClosure", "close_lips", "closed_frames", "closed_lip_columns", "inner_lip_aperture",
-           "learn_open_gain", "learn_threshold", "lip_closure", "open_lips", "separation"]
+__all__ = ["LipClosure", "bridge_jaw", "close_lips", "closed_frames", "closed_lip_columns",
+           "inner_lip_aperture", "learn_open_gain", "learn_threshold", "lip_closure", "open_lips",
+           "separation"]
 
 _DATA = "tracking/lip_closure.json"
 _JAW, _UPPER, _LOWER = (fap(name).index for name in ("open_jaw", "lower_t_midlip",
@@ -65,6 +71,8 @@ class LipClosure:
         closed state (a least-squares slope learned from the training renders).
     neighbours: ``{fap_id: share}`` raised by ``share`` times the raise of 4 (upper lip)
         or 5 (lower lip).
+    jaw_bridge_s: the longest closure (seconds) open_jaw is drawn across
+        (:func:`bridge_jaw`).
     """
 
     upper: np.ndarray
@@ -75,6 +83,7 @@ class LipClosure:
     closed_gap: float
     open_gain: float
     neighbours: dict[int, float]
+    jaw_bridge_s: float
 
 
 @cache
@@ -86,12 +95,14 @@ def lip_closure() -> LipClosure:
         rule = LipClosure(pairs[:, 0], pairs[:, 1], float(raw["close_below"]["value"]),
                           float(raw["open_above"]["value"]), float(raw["jaw_gain"]["value"]),
                           float(raw["closed_gap"]["value"]), float(raw["open_gain"]["value"]),
-                          {int(k): float(v) for k, v in raw["neighbours"]["value"].items()})
+                          {int(k): float(v) for k, v in raw["neighbours"]["value"].items()},
+                          float(raw["jaw_bridge_s"]["value"]))
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise DataError(f"malformed lip closure rule ({exc})", path=_DATA) from exc
-    if pairs.ndim != 2 or pairs.shape[1] != 2 or not rule.close_below <= rule.open_above:
-        raise DataError("lip closure rule: pairs must be (p, 2) and close_below <= open_above",
-                        path=_DATA)
+    if (pairs.ndim != 2 or pairs.shape[1] != 2 or not rule.close_below <= rule.open_above
+            or not rule.jaw_bridge_s >= 0):
+        raise DataError("lip closure rule: pairs must be (p, 2), close_below <= open_above "
+                        "and jaw_bridge_s >= 0", path=_DATA)
     return rule
 
 
@@ -151,6 +162,21 @@ def open_lips(values: np.ndarray, aperture: np.ndarray, closed: np.ndarray,
     short = np.maximum(rule.open_gain * np.asarray(aperture, np.float64)
                        - separation(values, rule), 0.0)
     return _close_by(values, -np.where(closed, 0.0, short), rule)
+
+
+def bridge_jaw(values: np.ndarray, closed: np.ndarray, *, longest: int) -> np.ndarray:
+    """``(n, 84)`` FAP values with open_jaw drawn straight across each run of ``closed``
+    ``(n,) bool`` frames of at most ``longest`` frames that has an open frame on either side
+    (from the value of the one before to that of the one after); other runs, and every other
+    FAP, as they were."""
+    out = np.array(values, np.float64)
+    edges = np.diff(np.concatenate([[0], np.asarray(closed, np.int8), [0]]))
+    for start, stop in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
+        if start > 0 and stop < len(out) and stop - start <= longest:
+            before, after = out[start - 1, _JAW], out[stop, _JAW]
+            share = np.arange(1, stop - start + 1) / (stop - start + 1)
+            out[start:stop, _JAW] = before + share * (after - before)
+    return out
 
 
 def closed_lip_columns(rule: LipClosure) -> list[int]:

@@ -11,9 +11,11 @@ from facelib.engine import default_face
 from facelib.errors import ParameterError
 from facelib.mpeg4 import N_FAPS, FapStream, fap
 from facelib.tracking.embedding import default_head_embedding
+from facelib.tracking.faps import measure_faps, mouth_closed
 from facelib.tracking.headframe import head_frame
 from facelib.tracking.layouts import landmark_layout
 from facelib.tracking.lipclosure import (
+    bridge_jaw,
     close_lips,
     closed_frames,
     inner_lip_aperture,
@@ -41,6 +43,7 @@ def test_packaged_rule():
     assert rule.closed_gap < 0
     # the open lips' gain: one MNS0 of MediaPipe's aperture is 1-4 MNS0 of true separation
     assert 1024 < rule.open_gain < 4096
+    assert 0.1 <= rule.jaw_bridge_s <= 0.4     # a p, b or m, not a pause
 
 
 def test_hysteresis():
@@ -64,6 +67,21 @@ def test_close_lips_lowers_the_separation_only_where_closed():
     np.testing.assert_allclose(out[:, 2], 200.0)  # open_jaw is left alone
     assert out[1, 3] == out[1, 4] > 0
     assert out[1, 7] == rule.neighbours[8] * out[1, 3]
+
+
+def test_bridge_jaw_draws_open_jaw_across_brief_closures_only():
+    values = np.zeros((14, N_FAPS))
+    values[:, 2] = [100, 300, 0, 0, 0, 500, 200, 0, 0, 0, 0, 0, 400, 0]  # open_jaw
+    values[:, 4] = 50.0                                                  # raise_b_midlip
+    closed = np.zeros(14, bool)
+    closed[[0, 2, 3, 4, 7, 8, 9, 10, 11, 13]] = True  # runs: 0 | 2-4 | 7-11 | 13
+    out = bridge_jaw(values, closed, longest=3)
+    np.testing.assert_allclose(out[2:5, 2], [350, 400, 450])   # 300 -> 500 in four steps
+    np.testing.assert_allclose(out[7:12, 2], 0.0)              # five frames: too long
+    assert out[0, 2] == 100 and out[13, 2] == 0                # no open frame on one side
+    np.testing.assert_allclose(np.delete(out, 2, axis=1), np.delete(values, 2, axis=1))
+    np.testing.assert_allclose(bridge_jaw(values, closed, longest=5)[7:12, 2],
+                               [200 + 200 * k / 6 for k in range(1, 6)])
 
 
 def test_open_lips_raises_the_separation_to_the_aperture_in_open_frames_only():
@@ -119,3 +137,19 @@ def test_learn_threshold_refuses_bad_input_with_a_parameter_error():
         learn_threshold(aperture, np.ones(4, bool))
     with pytest.raises(ParameterError, match="false_closed"):
         learn_threshold(aperture, np.ones(5, bool), false_closed=1.5)
+
+
+def test_a_recorded_track_draws_the_jaw_across_a_brief_closure():
+    values = np.zeros((24, N_FAPS), np.float32)
+    values[8:, fap("open_jaw").index] = 300         # speech: the jaw open throughout
+    values[14:17, fap("lower_t_midlip").index] = 350  # an m: the lips press shut over it
+    values[14:17, fap("raise_b_midlip").index] = 350
+    landmarks = camera(values)
+    smooth = measure_faps(landmarks, fps=25.0, neutral=(0, 8)).stream.values[:, 2]
+    raw = measure_faps(landmarks, fps=25.0, neutral=(0, 8), smooth=False).stream.values[:, 2]
+    frame = head_frame(landmarks, layout=landmark_layout("mediapipe"), span=slice(0, 8))
+    closed = mouth_closed(inner_lip_aperture(frame, lip_closure()))
+    assert closed[14:17].all() and not closed[[13, 17]].any()
+    np.testing.assert_allclose(smooth[14:17], smooth[13] + (smooth[17] - smooth[13])
+                               * np.arange(1, 4) / 4, rtol=1e-6)
+    assert not np.allclose(raw[14:17], raw[13] + (raw[17] - raw[13]) * np.arange(1, 4) / 4)
