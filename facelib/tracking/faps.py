@@ -38,7 +38,7 @@ import numpy as np
 from facelib.checks import check_fps
 from facelib.data import json_data
 from facelib.errors import DataError, ParameterError, TrackingError, TrackingWarning
-from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap_table
+from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap, fap_table
 from facelib.tracking import lipclosure
 from facelib.tracking.headframe import (
     HeadFrame,
@@ -110,15 +110,15 @@ def _plan(layout: LandmarkLayout, pose: HeadPose | None
     if pose is None:
         fixed = {"9.3"}
     plan = []
-    for fap in fap_table():
-        if fap.kind != "translation" or fap.axis not in ("x", "y"):
+    for entry in fap_table():
+        if entry.kind != "translation" or entry.axis not in ("x", "y"):
             continue
-        fp = fap.feature_points[0]
+        fp = entry.feature_points[0]
         if fp not in layout.feature_points or fp in fixed:
             continue
-        axis = _AXES[fap.axis]
-        plan.append((fap.index, layout.index(fp), axis, float(np.sign(fap.direction[axis])),
-                     fap.fapu))
+        axis = _AXES[entry.axis]
+        plan.append((entry.index, layout.index(fp), axis, float(np.sign(entry.direction[axis])),
+                     entry.fapu))
     return plan
 
 
@@ -348,9 +348,9 @@ def settle_faps(values: np.ndarray, mask: np.ndarray, *,
     in :func:`measure_faps`.
     """
     values = values.copy()
-    for fap in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
-        if fap.bidirectional is False and fap.min == 0:
-            values[:, fap.index] = np.maximum(values[:, fap.index], 0.0)
+    for entry in fap_table():  # unidirectional FAPs with a floor of 0 (open_jaw, thrust_jaw)
+        if entry.bidirectional is False and entry.min == 0:
+            values[:, entry.index] = np.maximum(values[:, entry.index], 0.0)
     if lips is not None:  # after the floor: the lip separation counts open_jaw as shown
         aperture, closed = lips
         rule = lipclosure.lip_closure()
@@ -439,8 +439,10 @@ def measure_faps(
     if smooth:  # the recorded track's time: the filter both ways, the jaw across closures
         values = _smooth(values, found.mask, rate)
         if lips_state is not None:
-            longest = round(lipclosure.lip_closure().jaw_bridge_s * rate)
-            values = lipclosure.bridge_jaw(values, lips_state[1], longest=longest)
+            jaw = fap("open_jaw").index
+            values[:, jaw] = lipclosure.bridge_jaw(
+                values[:, jaw], lips_state[1],
+                longest=round(lipclosure.lip_closure().jaw_bridge_s * rate))
     values, mask = settle_faps(values, found.mask, states=states, relations=relations,
                                lips=lips_state)
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)

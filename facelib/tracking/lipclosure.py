@@ -164,18 +164,17 @@ def open_lips(values: np.ndarray, aperture: np.ndarray, closed: np.ndarray,
     return _close_by(values, -np.where(closed, 0.0, short), rule)
 
 
-def bridge_jaw(values: np.ndarray, closed: np.ndarray, *, longest: int) -> np.ndarray:
-    """``(n, 84)`` FAP values with open_jaw drawn straight across each run of ``closed``
-    ``(n,) bool`` frames of at most ``longest`` frames that has an open frame on either side
-    (from the value of the one before to that of the one after); other runs, and every other
-    FAP, as they were."""
-    out = np.array(values, np.float64)
+def bridge_jaw(jaw: np.ndarray, closed: np.ndarray, *, longest: int) -> np.ndarray:
+    """``(n,) float64`` open_jaw values ``jaw`` ``(n,)`` drawn straight across each run of
+    ``closed`` ``(n,) bool`` frames of at most ``longest`` frames that has an open frame on
+    either side (from the value of the one before to that of the one after); the other
+    frames as they were."""
+    out = np.array(jaw, np.float64)
     edges = np.diff(np.concatenate([[0], np.asarray(closed, np.int8), [0]]))
     for start, stop in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
         if start > 0 and stop < len(out) and stop - start <= longest:
-            before, after = out[start - 1, _JAW], out[stop, _JAW]
             share = np.arange(1, stop - start + 1) / (stop - start + 1)
-            out[start:stop, _JAW] = before + share * (after - before)
+            out[start:stop] = out[start - 1] + share * (out[stop] - out[start - 1])
     return out
 
 

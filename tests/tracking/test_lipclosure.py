@@ -70,18 +70,16 @@ def test_close_lips_lowers_the_separation_only_where_closed():
 
 
 def test_bridge_jaw_draws_open_jaw_across_brief_closures_only():
-    values = np.zeros((14, N_FAPS))
-    values[:, 2] = [100, 300, 0, 0, 0, 500, 200, 0, 0, 0, 0, 0, 400, 0]  # open_jaw
-    values[:, 4] = 50.0                                                  # raise_b_midlip
+    jaw = np.array([100, 300, 0, 0, 0, 500, 200, 0, 0, 0, 0, 0, 400, 0], np.float64)
     closed = np.zeros(14, bool)
     closed[[0, 2, 3, 4, 7, 8, 9, 10, 11, 13]] = True  # runs: 0 | 2-4 | 7-11 | 13
-    out = bridge_jaw(values, closed, longest=3)
-    np.testing.assert_allclose(out[2:5, 2], [350, 400, 450])   # 300 -> 500 in four steps
-    np.testing.assert_allclose(out[7:12, 2], 0.0)              # five frames: too long
-    assert out[0, 2] == 100 and out[13, 2] == 0                # no open frame on one side
-    np.testing.assert_allclose(np.delete(out, 2, axis=1), np.delete(values, 2, axis=1))
-    np.testing.assert_allclose(bridge_jaw(values, closed, longest=5)[7:12, 2],
+    out = bridge_jaw(jaw, closed, longest=3)
+    np.testing.assert_allclose(out[2:5], [350, 400, 450])   # 300 -> 500 in four steps
+    np.testing.assert_allclose(out[7:12], 0.0)              # five frames: too long
+    np.testing.assert_allclose(out[[0, 1, 5, 6, 12, 13]], jaw[[0, 1, 5, 6, 12, 13]])
+    np.testing.assert_allclose(bridge_jaw(jaw, closed, longest=5)[7:12],
                                [200 + 200 * k / 6 for k in range(1, 6)])
+    assert jaw[3] == 0                                       # the input is left alone
 
 
 def test_open_lips_raises_the_separation_to_the_aperture_in_open_frames_only():
