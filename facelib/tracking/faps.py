@@ -433,19 +433,24 @@ def measure_faps(
     found = _join([measure_frames(data[cut], rest, layout=layout, model=model, lips=lips,
                                   brows=None if shifts is None else shifts[cut])
                    for cut in _chunks(len(data))])
-    lips_state = None if found.aperture is None else (found.aperture,
-                                                        mouth_closed(found.aperture))
-    values = found.values
-    if smooth:  # the recorded track's time: the filter both ways, the jaw across closures
-        values = _smooth(values, found.mask, rate)
-        if lips_state is not None:
-            jaw = fap("open_jaw").index
-            values[:, jaw] = lipclosure.bridge_jaw(
-                values[:, jaw], lips_state[1],
-                longest=round(lipclosure.lip_closure().jaw_bridge_s * rate))
-    values, mask = settle_faps(values, found.mask, states=states, relations=relations,
-                               lips=lips_state)
+    mouth = None if found.aperture is None else (found.aperture, mouth_closed(found.aperture))
+    values, mask = settle_faps(  # the smoothed values are passed on, not kept: one copy less
+        _over_time(found, rate, None if mouth is None else mouth[1]) if smooth else found.values,
+        found.mask, states=states, relations=relations, lips=mouth)
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
+
+
+def _over_time(found: MeasuredFrames, rate: float, closed: np.ndarray | None) -> np.ndarray:
+    """The steps that need the whole recorded track, on ``found``'s ``(n, 84)`` values: the
+    One Euro filter both ways, then open_jaw drawn across the brief runs of ``closed``
+    ``(n,) bool`` frames (:func:`~facelib.tracking.lipclosure.bridge_jaw`; None: no mouth
+    state)."""
+    values = _smooth(found.values, found.mask, rate)
+    if closed is not None:
+        jaw = fap("open_jaw").index
+        values[:, jaw] = lipclosure.bridge_jaw(
+            values[:, jaw], closed, longest=round(lipclosure.lip_closure().jaw_bridge_s * rate))
+    return values
 
 
 def _neutral(data: np.ndarray, filled: tuple[int, ...], neutral: int | tuple[int, int] | None,
