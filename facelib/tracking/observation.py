@@ -266,7 +266,7 @@ def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
         raise ParameterError(f"region landmarks must be distinct rows in 0-{moved.shape[1] - 1}"
                              f", got {region.landmarks!r}")
     most = min(2 * rows.size, len(moved) - 2)
-    if not 1 <= check_count("region components", region.components, low=1) <= most:
+    if check_count("region components", region.components, low=1) > most:
         raise ParameterError(f"region components must be 1-{most} for {rows.size} landmarks "
                              f"and {len(moved)} frames, got {region.components}")
     basis, scores = _principal(moved[:, rows].reshape(len(moved), -1), region.components)
