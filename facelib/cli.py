@@ -990,9 +990,11 @@ def _dispatch(run: Callable[[argparse.Namespace, Console], int], args: argparse.
         return _stopped(signal.SIGINT)
     except Terminated:
         return _stopped(signal.SIGTERM)
-    except FacelibError as exc:
+    except Exception as exc:
         if console.signals.received is not None:  # a library turned the signal into an error
-            return _stopped(console.signals.received)
+            return _stopped(console.signals.received)  # (ctypes: into an ArgumentError)
+        if not isinstance(exc, FacelibError):
+            raise
         if console.verbose:
             traceback.print_exc()
         print(f"facelib: error: {exc}", file=sys.stderr)

@@ -141,6 +141,28 @@ def test_signals_exit_with_one_line_and_no_temporary_files(tmp_path, sig, status
     assert list(out_dir.iterdir()) == []
 
 
+def test_a_signal_a_library_turned_into_another_error_still_exits_as_that_signal(capsys):
+    # SIGTERM arriving inside pyrender's ctypes call to OSMesa reaches the command as a
+    # ctypes.ArgumentError wrapping Terminated, not as Terminated itself
+    import argparse
+    import ctypes
+
+    from facelib.cli import Console, _dispatch
+
+    def run(args, console):
+        console.signals.received = signal.SIGTERM
+        raise ctypes.ArgumentError("argument 2: Terminated: ")
+
+    assert _dispatch(run, argparse.Namespace(), Console()) == 143
+    assert capsys.readouterr().err.strip() == "facelib: terminated"
+
+    def broken(args, console):
+        raise ValueError("a bug, with no signal")
+
+    with pytest.raises(ValueError, match="a bug"):
+        _dispatch(broken, argparse.Namespace(), Console())
+
+
 def test_exit_codes_are_documented():
     text = (ROOT / "docs" / "getting-started.md").read_text()
     for code in ("130", "141", "143"):
