@@ -103,7 +103,9 @@ class SpeechSpec:
 
     ``lang`` is the language (None: the storyboard's); ``voice``, ``rate`` (1.0 = 175 words
     per minute) and ``pitch`` (0-100, 50 = the voice's own) shape synthesized speech for
-    text without audio (``voice`` None: the language's espeak-ng voice).
+    text without audio (``voice`` None: the language's espeak-ng voice). ``style`` says how
+    strongly it is articulated: a style name (``"mumble"``, ``"normal"``, ``"emphatic"``)
+    or a number for both the jaw and the lip level (:mod:`facelib.visemes.articulation`).
     """
 
     audio: Path | None = None
@@ -115,6 +117,7 @@ class SpeechSpec:
     voice: str | None = None
     rate: float = 1.0
     pitch: float = 50.0
+    style: str | float = "normal"
 
 
 def _frozen_map(value: Mapping[str, Any]) -> Mapping[str, Any]:

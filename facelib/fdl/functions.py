@@ -56,7 +56,7 @@ FUNCTIONS: Mapping[str, StoryboardFunction] = MappingProxyType({
     for f in (
         StoryboardFunction(
             "say", ("text", "transcript", "audio", "visemes", "at", "lang", "voice", "rate",
-                    "pitch"),
+                    "pitch", "style"),
             'say { "Hello.", audio = "hello.wav", at = 0.5 }', modern.read_say,
             takes_string=True,
         ),

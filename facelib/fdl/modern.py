@@ -69,6 +69,7 @@ class DraftSpeech:
     voice: str | None = None
     rate: float = 1.0
     pitch: float = 50.0
+    style: str | float = "normal"
 
 
 @dataclass(slots=True)
@@ -257,7 +258,18 @@ def read_say(
         voice=strings["voice"],
         rate=numbers["rate"] if numbers["rate"] is not None else 1.0,
         pitch=numbers["pitch"] if numbers["pitch"] is not None else 50.0,
+        style=_style(f, ctx, line),
     )
+
+
+def _style(fields: Mapping[str, LuaValue], ctx: Context, line: int | None) -> str | float:
+    """``say``'s ``style``: a style name or a number ("normal" when absent); the speech
+    generator checks the name and range against its table."""
+    value = fields.get("style", "normal")
+    if isinstance(value, bool) or not isinstance(value, str | int | float):
+        raise FdlError(f"say: style must be a name (mumble, normal, emphatic) or a number; "
+                       f"got {value!r}", path=ctx.path, line=line)
+    return value if isinstance(value, str) else float(value)
 
 
 def _ranged(

@@ -75,4 +75,4 @@ def speech_spec(said: DraftSpeech, ctx: Context) -> SpeechSpec:
         text = read_text(transcript, what="transcript", path=ctx.path, line=said.line)
     return SpeechSpec(audio=audio, text=text, visemes=visemes, start_ms=said.at_ms,
                       origin=ctx.origin(said.line), lang=said.lang, voice=said.voice,
-                      rate=said.rate, pitch=said.pitch)
+                      rate=said.rate, pitch=said.pitch, style=said.style)

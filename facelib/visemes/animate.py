@@ -11,17 +11,18 @@ import numpy as np
 
 from facelib.checks import check_fps, check_kind, check_number
 from facelib.cues import MAX_FRAMES, MAX_SPEECH_TEXT_CHARS, SpeechSpec
-from facelib.errors import MissingExtraError, SpeechError, SpeechWarning
+from facelib.errors import MissingExtraError, ParameterError, SpeechError, SpeechWarning
 from facelib.mpeg4.track import FapTrack
 from facelib.speech import align as align_phones
 from facelib.speech import timeline_from_text as phones_from_text
 from facelib.speech.align import OnImplausible
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.dtw import align_dtw as align_phones_dtw
-from facelib.speech.loudness import FLOOR_DB, phone_loudness
+from facelib.speech.loudness import FLOOR_DB, window_loudness
 from facelib.speech.synth import DEFAULT_LANGUAGE
 from facelib.speech.synth import synthesize as synthesize_speech
 from facelib.speech.timeline import PhoneTimeline
+from facelib.visemes.articulation import span_levels
 from facelib.visemes.coarticulation import (
     blend,
     driven_faps,
@@ -173,7 +174,8 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     coarticulation blend of the viseme targets, faded to neutral with the speech envelope,
     which is also the weight on the driven FAPs (0 elsewhere): weights and values fade
     together, so a lone viseme track eases out instead of dropping to 0 in one frame.
-    Louder speech opens the jaw further (:mod:`facelib.visemes.loudness`).
+    Louder speech opens the jaw further (:mod:`facelib.visemes.loudness`); the speech's
+    ``style`` sets the jaw and lip levels (:mod:`facelib.visemes.articulation`).
     ``rate`` multiplies the speech's own speaking rate; ``language`` is the storyboard's.
     Speech longer than ``max_frames`` raises SpeechError before the curves are computed.
     """
@@ -193,7 +195,8 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     loudness = _frame_loudness(speech, own, audio, times - speech.start_ms)
     env = envelope(timeline.visemes, times)
     gain = jaw_gain(loudness, rules=loudness_rules())
-    values = blend(timeline.visemes, times, jaw_gain=gain) * env[:, None]
+    levels = _levels(speech, timeline)
+    values = blend(timeline.visemes, times, jaw_gain=gain, levels=levels) * env[:, None]
     weight = np.zeros_like(values)
     weight[:, driven_faps()] = env[:, None]
     speaking = speaking_mask(timeline.visemes, times)
@@ -202,10 +205,21 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
                            audio, loudness)
 
 
+def _levels(speech: SpeechSpec, timeline: SpeechTimeline) -> np.ndarray:
+    """Each span's jaw and lip levels for the speech's style; SpeechError at the ``say``."""
+    try:
+        return span_levels(timeline.visemes, style=speech.style)
+    except ParameterError as exc:
+        path, line = speech.origin if speech.origin else (None, None)
+        raise SpeechError(f"say: {exc.message}", path=path, line=line) from exc
+
+
 def _frame_loudness(speech: SpeechSpec, timeline: SpeechTimeline, audio: SpeechAudio | None,
                     times_ms: np.ndarray) -> np.ndarray:
-    """``(n_frames,) float32`` dBFS of the phone under each frame (times in the speech's own
-    ms); the floor where there is no audio or no phone."""
+    """``(n_frames,) float32`` dBFS of the speech around each frame (times in the speech's
+    own ms): the RMS level over the ``loudness_window_ms`` centred on the frame, so the jaw
+    follows the speech envelope within a phone as well as from phone to phone; the floor
+    outside phones and where there is no audio."""
     out = np.full(times_ms.size, FLOOR_DB, np.float32)
     phones = timeline.phones
     if phones and (audio is not None or speech.audio is not None):
@@ -213,11 +227,15 @@ def _frame_loudness(speech: SpeechSpec, timeline: SpeechTimeline, audio: SpeechA
             samples, sample_rate = audio.samples, audio.sample_rate
         else:
             samples, sample_rate = load_speech(speech.audio), ALIGN_RATE  # type: ignore[arg-type]
-        levels = phone_loudness(samples, sample_rate=sample_rate, spans=phones)
+        half = loudness_rules()["window_ms"] / 2
+        centre = np.round(times_ms).astype(np.int64)
+        levels = window_loudness(samples, sample_rate=sample_rate,
+                                 starts_ms=np.maximum(centre - int(half), 0),
+                                 ends_ms=centre + int(half))
         starts = np.array([p.start_ms for p in phones], np.float64)
         ends = np.array([p.end_ms for p in phones], np.float64)
         k = np.clip(np.searchsorted(starts, times_ms, side="right") - 1, 0, len(phones) - 1)
         inside = (times_ms >= starts[k]) & (times_ms < ends[k])
-        out[inside] = levels[k[inside]]
+        out[inside] = levels[inside]
     out.flags.writeable = False
     return out

@@ -13,10 +13,12 @@ import numpy as np
 
 from facelib.errors import ParameterError
 from facelib.mpeg4.tables import N_FAPS, fap
+from facelib.visemes.articulation import bound
 from facelib.visemes.tables import (
     coarticulation_classes,
     dominance_table,
     lower_lip_per_jaw,
+    peak_hold,
     timing_rules,
     viseme_targets,
 )
@@ -59,16 +61,21 @@ def window_ms() -> float:
 
 
 def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray, *,
-          jaw_gain: np.ndarray | None = None) -> np.ndarray:
+          jaw_gain: np.ndarray | None = None, levels: np.ndarray | None = None) -> np.ndarray:
     """FAP values ``(len(times_ms), 84) float32`` (FAP units) of the viseme sequence.
 
     For each FAP class k (jaw, lip height, lip shape, tongue) and span s the dominance is
     ``alpha_sk * exp(-theta_sk * d)``, d the distance in seconds from the time to the span
-    (0 inside it; ``theta_before`` before it, ``theta_after`` after it). Each FAP is the
-    dominance-weighted mean of the spans' targets. The lips then close on every p/b/m
+    (``theta_before`` before it, ``theta_after`` after it); inside the span it grows as
+    ``alpha_sk * exp(hold * depth)``, depth the distance to the span's nearer end, so that a
+    long span reaches its target while a short one still blends with its neighbours
+    (``peak_hold`` of the data file). Each FAP is the dominance-weighted mean of the spans'
+    targets, each span's scaled by its ``levels`` (``(len(visemes), 2)``: the jaw class by
+    column 0, the lip classes by column 1; see :mod:`facelib.visemes.articulation`; None: 1). The lips then close on every p/b/m
     (see ``_close_bilabials``). FAPs outside the classes stay 0. ``jaw_gain``
-    (``(len(times_ms),)``, from the speech's loudness) scales the jaw opening before the
-    bilabial closure, so p/b/m still close.
+    (``(len(times_ms),)``, from the speech's loudness) scales the jaw opening; then the
+    values are held within the anatomical bounds (:func:`facelib.visemes.articulation.bound`),
+    both before the bilabial closure, so p/b/m still close.
 
     Frames are taken in chunks, each with the spans within :func:`window_ms` of it only, so
     memory and time grow linearly with the length of the speech (``times_ms`` ascending).
@@ -87,20 +94,29 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray, *,
         first = min(int(np.searchsorted(end, t.min() - reach, side="left")), n_spans - 1)
         last = max(int(np.searchsorted(start, t.max() + reach, side="right")), first + 1)
         part = slice(first, last)
-        out[lo:lo + t.size] = _blend_dense(ids[part], start[part], end[part], t)
+        scale = None if levels is None else levels[part]
+        out[lo:lo + t.size] = _blend_dense(ids[part], start[part], end[part], t, scale)
     if jaw_gain is not None:
         out[:, fap("open_jaw").index] *= np.asarray(jaw_gain, np.float32)
+    bound(out)
     _close_bilabials(out, visemes, times, reach)
     return out
 
 
+_LEVEL_COLUMN = {"jaw": 0, "lip_height": 1, "lip_shape": 1}
+"""Which articulation level scales each FAP class (the tongue keeps its targets)."""
+
+
 def _blend_dense(ids: np.ndarray, start: np.ndarray, end: np.ndarray,
-                 times: np.ndarray) -> np.ndarray:
+                 times: np.ndarray, levels: np.ndarray | None = None) -> np.ndarray:
     """The dominance blend of spans ``ids`` ``[start, end)`` at ``times``: ``(len(times),
     84) float32``, with a ``(len(times), len(ids))`` dominance matrix per FAP class."""
     out = np.zeros((times.size, N_FAPS), np.float32)
     before = np.maximum(start[None, :] - times[:, None], 0.0) / 1000.0  # (n_frames, n_spans)
     after = np.maximum(times[:, None] - end[None, :], 0.0) / 1000.0
+    depth = np.maximum(np.minimum(times[:, None] - start[None, :],
+                                  end[None, :] - times[:, None]), 0.0) / 1000.0
+    held = peak_hold() * depth
     targets = viseme_targets()[ids]  # (n_spans, 84)
     table = dominance_table()
     for cls, columns in coarticulation_classes().items():
@@ -109,11 +125,15 @@ def _blend_dense(ids: np.ndarray, start: np.ndarray, end: np.ndarray,
         theta_b = np.array([p.theta_before for p in params])
         theta_a = np.array([p.theta_after for p in params])
         # log-domain so far-away spans underflow to 0 instead of overflowing anything
-        log_dom = np.log(alpha)[None, :] - theta_b[None, :] * before - theta_a[None, :] * after
+        log_dom = (np.log(alpha)[None, :] - theta_b[None, :] * before
+                   - theta_a[None, :] * after + held)
         log_dom -= log_dom.max(axis=1, keepdims=True)
         dom = np.exp(log_dom)
         cols = list(columns)
-        out[:, cols] = (dom @ targets[:, cols]) / dom.sum(axis=1, keepdims=True)
+        shown = targets[:, cols]
+        if levels is not None and cls in _LEVEL_COLUMN:
+            shown = shown * levels[:, _LEVEL_COLUMN[cls], None]
+        out[:, cols] = (dom @ shown) / dom.sum(axis=1, keepdims=True)
     return out
 
 

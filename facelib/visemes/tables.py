@@ -37,6 +37,7 @@ __all__ = [
     "dominance_table",
     "loudness_rules",
     "lower_lip_per_jaw",
+    "peak_hold",
     "phone_viseme",
     "script_name",
     "timing_rules",
@@ -177,6 +178,16 @@ def loudness_rules() -> Mapping[str, float]:
 def lower_lip_per_jaw() -> float:
     """MNS of lower-lip drop per unit of open_jaw (``lower_lip_per_jaw`` of the data file)."""
     return float(_coarticulation().get("lower_lip_per_jaw", 1.0))
+
+
+@cache
+def peak_hold() -> float:
+    """``peak_hold`` of the data file (1/s): how fast a span's dominance grows with the
+    depth into the span (see :func:`facelib.visemes.coarticulation.blend`)."""
+    value = float(_coarticulation().get("peak_hold", 0.0))
+    if not value >= 0:
+        raise DataError(f"peak_hold must be >= 0, got {value}", path=_where("coarticulation.json"))
+    return value
 
 
 @cache

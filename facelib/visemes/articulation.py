@@ -1,0 +1,112 @@
+"""How strongly speech is articulated: jaw and lip levels per span (JALI's two axes).
+
+A speech's ``style`` (``"mumble"``, ``"normal"``, ``"emphatic"`` or a number) gives a jaw
+level and a lip level; reduced vowels (schwa) take a share of them; the viseme blend
+multiplies each span's targets by its levels (:func:`facelib.visemes.coarticulation.blend`),
+and :func:`bound` keeps the result within the face's anatomical range. Rules in
+``facelib/data/visemes/articulation.json``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from functools import cache
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from facelib import data
+from facelib.checks import did_you_mean
+from facelib.errors import DataError, ParameterError
+from facelib.mpeg4.tables import N_FAPS, fap
+from facelib.visemes.timeline import VisemeSpan
+
+__all__ = ["Style", "bound", "span_levels", "style_levels", "style_names"]
+
+Style = str | float
+"""A style name of the data file or a number (both levels set to it)."""
+
+_FILE = "visemes/articulation.json"
+
+
+@cache
+def _rules() -> dict[str, Any]:
+    doc: dict[str, Any] = data.json_data(_FILE)
+    return doc
+
+
+@cache
+def _styles() -> Mapping[str, tuple[float, float]]:
+    raw = _rules()["styles"]
+    out = {name: (float(row["jaw"]), float(row["lip"]))
+           for name, row in raw.items() if not name.startswith("_")}
+    if any(not 0 < v <= 2 for pair in out.values() for v in pair):
+        raise DataError(f"style levels must lie in (0, 2]: {out}", path=data.path(_FILE))
+    return MappingProxyType(out)
+
+
+def style_names() -> tuple[str, ...]:
+    """The named styles a speech may take (``mumble``, ``normal``, ``emphatic``, ...)."""
+    return tuple(_styles())
+
+
+def style_levels(style: Style) -> tuple[float, float]:
+    """``(jaw, lip)`` levels of ``style``: a name of the data file, or a number within the
+    file's ``number_range`` for both. ParameterError otherwise, with the choices."""
+    if isinstance(style, bool):
+        raise ParameterError(f"style must be a name or a number, got {style!r}")
+    if isinstance(style, int | float):
+        low, high = (float(v) for v in _rules()["number_range"])
+        if not low <= float(style) <= high:
+            raise ParameterError(f"style must be a number from {low:g} to {high:g} or one of "
+                                 f"{', '.join(style_names())}; got {style!r}")
+        return float(style), float(style)
+    if not isinstance(style, str):
+        raise ParameterError(f"style must be a name or a number, got {style!r}")
+    styles = _styles()
+    if style not in styles:
+        raise ParameterError(f"unknown speech style {style!r} (one of "
+                             f"{', '.join(styles)}, or a number){did_you_mean(style, styles)}")
+    return styles[style]
+
+
+@cache
+def _reduced() -> tuple[frozenset[str], float]:
+    raw = _rules()["reduced_vowels"]
+    return frozenset(str(p) for p in raw["phones"]), float(raw["level"])
+
+
+def span_levels(visemes: Sequence[VisemeSpan], *, style: Style = "normal") -> np.ndarray:
+    """``(len(visemes), 2) float64``: each span's jaw and lip levels, the style's, times the
+    reduced-vowel level for a span whose phones are all reduced vowels."""
+    jaw, lip = style_levels(style)
+    reduced, level = _reduced()
+    out = np.empty((len(visemes), 2))
+    out[:] = (jaw, lip)
+    for i, span in enumerate(visemes):
+        if span.phones and all(p in reduced for p in span.phones):
+            out[i] *= level
+    return out
+
+
+@cache
+def _limits() -> np.ndarray:
+    """``(84,) float32``: the largest magnitude each FAP may reach (inf where unbounded)."""
+    limits = np.full(N_FAPS, np.inf, np.float32)
+    for name, value in _rules()["bounds"].items():
+        if name.startswith("_"):
+            continue
+        try:
+            limits[fap(name).index] = float(value)
+        except ParameterError as exc:
+            raise DataError(f"bounds: {exc.message}", path=data.path(_FILE)) from exc
+    limits.flags.writeable = False
+    return limits
+
+
+def bound(values: np.ndarray) -> np.ndarray:
+    """``values`` ``(n, 84)`` FAP units clipped to the anatomical bounds, in place; returned."""
+    limits = _limits()
+    np.clip(values, -limits, limits, out=values)
+    return values
