@@ -22,7 +22,8 @@ from facelib.errors import DataError, ParameterError
 from facelib.mpeg4.tables import N_FAPS, fap
 from facelib.visemes.timeline import VisemeSpan
 
-__all__ = ["Style", "bound", "span_levels", "style_levels", "style_names"]
+__all__ = ["Style", "bound", "is_reduced", "limits", "span_levels", "style_levels",
+           "style_names"]
 
 Style = str | float
 """A style name of the data file or a number (both levels set to it)."""
@@ -77,36 +78,43 @@ def _reduced() -> tuple[frozenset[str], float]:
     return frozenset(str(p) for p in raw["phones"]), float(raw["level"])
 
 
+def is_reduced(span: VisemeSpan) -> bool:
+    """Whether ``span`` shows only reduced vowels (schwa and kin: ``reduced_vowels``)."""
+    reduced = _reduced()[0]
+    return bool(span.phones) and all(p in reduced for p in span.phones)
+
+
 def span_levels(visemes: Sequence[VisemeSpan], *, style: Style = "normal") -> np.ndarray:
     """``(len(visemes), 2) float64``: each span's jaw and lip levels, the style's, times the
     reduced-vowel level for a span whose phones are all reduced vowels."""
-    jaw, lip = style_levels(style)
-    reduced, level = _reduced()
     out = np.empty((len(visemes), 2))
-    out[:] = (jaw, lip)
-    for i, span in enumerate(visemes):
-        if span.phones and all(p in reduced for p in span.phones):
-            out[i] *= level
+    out[:] = style_levels(style)
+    out[[is_reduced(s) for s in visemes]] *= _reduced()[1]
     return out
 
 
 @cache
-def _limits() -> np.ndarray:
-    """``(84,) float32``: the largest magnitude each FAP may reach (inf where unbounded)."""
-    limits = np.full(N_FAPS, np.inf, np.float32)
+def limits() -> tuple[np.ndarray, np.ndarray]:
+    """``(low, high)``, each ``(84,) float32``: the range each FAP may reach in speech
+    (``-inf``/``inf`` where the data file sets no bound)."""
+    low = np.full(N_FAPS, -np.inf, np.float32)
+    high = np.full(N_FAPS, np.inf, np.float32)
     for name, value in _rules()["bounds"].items():
         if name.startswith("_"):
             continue
         try:
-            limits[fap(name).index] = float(value)
-        except ParameterError as exc:
-            raise DataError(f"bounds: {exc.message}", path=data.path(_FILE)) from exc
-    limits.flags.writeable = False
-    return limits
+            k = fap(name).index
+            low[k], high[k] = (float(v) for v in value)
+        except (ParameterError, TypeError, ValueError) as exc:
+            raise DataError(f"bounds: {name}: expected a FAP name and [low, high], got "
+                            f"{value!r}", path=data.path(_FILE)) from exc
+        if not low[k] < 0 < high[k]:
+            raise DataError(f"bounds: {name}: {value!r} must contain 0", path=data.path(_FILE))
+    low.flags.writeable = high.flags.writeable = False
+    return low, high
 
 
 def bound(values: np.ndarray) -> np.ndarray:
     """``values`` ``(n, 84)`` FAP units clipped to the anatomical bounds, in place; returned."""
-    limits = _limits()
-    np.clip(values, -limits, limits, out=values)
+    np.clip(values, *limits(), out=values)
     return values

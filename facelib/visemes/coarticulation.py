@@ -66,10 +66,10 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray, *,
 
     For each FAP class k (jaw, lip height, lip shape, tongue) and span s the dominance is
     ``alpha_sk * exp(-theta_sk * d)``, d the distance in seconds from the time to the span
-    (``theta_before`` before it, ``theta_after`` after it); inside the span it grows as
-    ``alpha_sk * exp(hold * depth)``, depth the distance to the span's nearer end, so that a
-    long span reaches its target while a short one still blends with its neighbours
-    (``peak_hold`` of the data file). Each FAP is the dominance-weighted mean of the spans'
+    (``theta_before`` before it, ``theta_after`` after it); inside a vowel's span it grows
+    as ``alpha_sk * exp(hold * depth)``, depth the distance to the span's nearer end, so
+    that a long vowel reaches its target while a short one still blends with its
+    neighbours (``peak_hold`` of the data file). Each FAP is the dominance-weighted mean of the spans'
     targets, each span's scaled by its ``levels`` (``(len(visemes), 2)``: the jaw class by
     column 0, the lip classes by column 1; see :mod:`facelib.visemes.articulation`; None: 1). The lips then close on every p/b/m
     (see ``_close_bilabials``). FAPs outside the classes stay 0. ``jaw_gain``
@@ -116,7 +116,7 @@ def _blend_dense(ids: np.ndarray, start: np.ndarray, end: np.ndarray,
     after = np.maximum(times[:, None] - end[None, :], 0.0) / 1000.0
     depth = np.maximum(np.minimum(times[:, None] - start[None, :],
                                   end[None, :] - times[:, None]), 0.0) / 1000.0
-    held = peak_hold() * depth
+    held = peak_hold()[ids][None, :] * depth
     targets = viseme_targets()[ids]  # (n_spans, 84)
     table = dominance_table()
     for cls, columns in coarticulation_classes().items():

@@ -181,13 +181,22 @@ def lower_lip_per_jaw() -> float:
 
 
 @cache
-def peak_hold() -> float:
-    """``peak_hold`` of the data file (1/s): how fast a span's dominance grows with the
-    depth into the span (see :func:`facelib.visemes.coarticulation.blend`)."""
-    value = float(_coarticulation().get("peak_hold", 0.0))
-    if not value >= 0:
-        raise DataError(f"peak_hold must be >= 0, got {value}", path=_where("coarticulation.json"))
-    return value
+def peak_hold() -> np.ndarray:
+    """``(15,) float64`` 1/s: how fast each viseme's dominance grows with the depth into its
+    own span (``peak_hold`` of the data file; 0 for visemes it does not hold; see
+    :func:`facelib.visemes.coarticulation.blend`)."""
+    raw = _coarticulation().get("peak_hold", {"rate": 0.0, "visemes": []})
+    path = _where("coarticulation.json")
+    rate = float(raw["rate"])
+    if not rate >= 0:
+        raise DataError(f"peak_hold rate must be >= 0, got {rate}", path=path)
+    out = np.zeros(N_VISEMES)
+    try:
+        out[[viseme_id(name) for name in raw["visemes"]]] = rate
+    except ParameterError as exc:
+        raise DataError(f"peak_hold: {exc.message}", path=path) from exc
+    out.flags.writeable = False
+    return out
 
 
 @cache

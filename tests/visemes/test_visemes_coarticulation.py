@@ -38,8 +38,10 @@ def test_bilabial_closes_lips_even_inside_open_vowels():
     jaw_drop = lower_lip_per_jaw() * (values[inside, JAW] - pp[fap("open_jaw").index])
     gap = jaw_drop - (values[inside, LOWER] - pp[LOWER])
     np.testing.assert_allclose(gap, 0.0, atol=1e-3)
-    # the closure is smooth: no frame-to-frame jump larger than the vowel's lip travel
-    assert np.abs(np.diff(values[:, LOWER])).max() < 120
+    # the closure is smooth: the lower lip travels to the seal over several 10 ms steps
+    # (no step more than a fifth of its whole travel)
+    travel = np.ptp(values[:, LOWER])
+    assert np.abs(np.diff(values[:, LOWER])).max() < travel / 5
 
 
 def test_bilabial_shorter_than_a_frame_still_closes():
