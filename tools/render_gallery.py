@@ -1,4 +1,4 @@
-"""Render the default head's expressions and visemes to the docs gallery.
+"""Render the default head's expressions to the docs gallery (visemes: render_visemes.py).
 
     PYTHONPATH=. python tools/render_gallery.py docs/images
     PYTHONPATH=. python tools/render_gallery.py docs/images --review /work/review
@@ -6,7 +6,6 @@
 writes into the folder given:
 
 - ``expressions.png``: every library expression at full intensity, default ("face") framing;
-- ``visemes.png``: the 15 MPEG-4 visemes, framed on the mouth;
 - ``expression_heatmaps.png``: skin displacement (mm, 0 blue to 15 red) of joy, fear and
   surprise, facelib's deformation above the head's own ARKit target mix below;
 
@@ -27,7 +26,6 @@ from facelib.engine import load_face
 from facelib.expressions import default_library
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import save_png
-from facelib.visemes import viseme_name, viseme_targets
 
 UNIVERSAL = ("joy", "sadness", "anger", "fear", "disgust", "surprise")
 HEAT_MAX_MM = 15.0
@@ -101,12 +99,6 @@ def main() -> None:
     with FaceRenderer(face, width=300, height=360) as renderer:
         pictures = [_label(renderer.frame(face.deform_frame(v)), k) for k, v in poses.items()]
         save_png(_sheet(pictures, 4), out / "expressions.png")
-    fp = face.feature_points
-    around_mouth = face.vertices[[fp[k] for k in ("8.3", "8.4", "9.15", "2.1")]]
-    with FaceRenderer(face, width=240, height=180, framing=around_mouth) as renderer:
-        mouth = [_label(renderer.frame(face.deform_frame(values)), f"{vid} {viseme_name(vid)}")
-                 for vid, values in enumerate(viseme_targets())]
-        save_png(_sheet(mouth, 5), out / "visemes.png")
     heatmaps(face, out)
     if args.review:
         review_sheet(face, args.review)

@@ -43,7 +43,7 @@ def _styles() -> Mapping[str, tuple[float, float]]:
     out = {name: (float(row["jaw"]), float(row["lip"]))
            for name, row in raw.items() if not name.startswith("_")}
     if any(not 0 < v <= 2 for pair in out.values() for v in pair):
-        raise DataError(f"style levels must lie in (0, 2]: {out}", path=data.path(_FILE))
+        raise DataError(f"style levels must lie in (0, 2]: {out}", path=str(data.path(_FILE)))
     return MappingProxyType(out)
 
 
@@ -107,9 +107,9 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
             low[k], high[k] = (float(v) for v in value)
         except (ParameterError, TypeError, ValueError) as exc:
             raise DataError(f"bounds: {name}: expected a FAP name and [low, high], got "
-                            f"{value!r}", path=data.path(_FILE)) from exc
+                            f"{value!r}", path=str(data.path(_FILE))) from exc
         if not low[k] < 0 < high[k]:
-            raise DataError(f"bounds: {name}: {value!r} must contain 0", path=data.path(_FILE))
+            raise DataError(f"bounds: {name}: {value!r} must contain 0", path=str(data.path(_FILE)))
     low.flags.writeable = high.flags.writeable = False
     return low, high
 

@@ -69,9 +69,10 @@ def blend(visemes: Sequence[VisemeSpan], times_ms: np.ndarray, *,
     (``theta_before`` before it, ``theta_after`` after it); inside a vowel's span it grows
     as ``alpha_sk * exp(hold * depth)``, depth the distance to the span's nearer end, so
     that a long vowel reaches its target while a short one still blends with its
-    neighbours (``peak_hold`` of the data file). Each FAP is the dominance-weighted mean of the spans'
-    targets, each span's scaled by its ``levels`` (``(len(visemes), 2)``: the jaw class by
-    column 0, the lip classes by column 1; see :mod:`facelib.visemes.articulation`; None: 1). The lips then close on every p/b/m
+    neighbours (``peak_hold`` of the data file). Each FAP is the dominance-weighted mean
+    of the spans' targets, each span's scaled by its ``levels`` (``(len(visemes), 2)``: the
+    jaw class by column 0, the lip classes by column 1; see
+    :mod:`facelib.visemes.articulation`; None: 1). The lips then close on every p/b/m
     (see ``_close_bilabials``). FAPs outside the classes stay 0. ``jaw_gain``
     (``(len(times_ms),)``, from the speech's loudness) scales the jaw opening; then the
     values are held within the anatomical bounds (:func:`facelib.visemes.articulation.bound`),
