@@ -13,6 +13,7 @@ from gltf_eval import Gltf, busy_stream
 from facelib.data import json_data
 from facelib.engine import default_face
 from facelib.export import export_gltf
+from facelib.mpeg4 import fap
 
 WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
 
@@ -116,3 +117,35 @@ def test_exports_are_lazy_names_of_facelib():
 
     assert facelib.export_gltf is ex.export_gltf and facelib.import_arkit is ex.import_arkit
     assert {"export_gltf", "export_html", "export_arkit", "import_arkit"} <= set(facelib.__all__)
+
+
+def test_no_negative_morph_weights_a_signed_fap_is_two_targets(tmp_path):
+    """Blender's importer clamps morph weights to [0, 1] (issue 36): every weight the file
+    animates is in [0, 1]; a FAP with values of both signs is two targets, one per sign, and
+    their weighted sum is the FAP's displacement."""
+    from facelib import FapStream
+
+    n = 9
+    values = np.zeros((n, 84), np.float32)
+    values[:, fap("raise_b_midlip").index] = np.linspace(-300, 200, n)  # both signs
+    values[:, fap("open_jaw").index] = np.linspace(0, 400, n)  # positive only
+    values[:, fap("stretch_l_cornerlip").index] = np.linspace(0, -150, n)  # negative only
+    stream = FapStream(25, values, np.ones((n, 84), bool))
+    result = export_gltf(stream, tmp_path / "signs.glb")
+    gltf = Gltf(result.path)
+    gltf.local_matrices(0)
+    animated = np.stack([(gltf.local_matrices(i), gltf._weights)[1] for i in range(n)])
+    assert animated.min() >= 0 and animated.max() <= 1 + 1e-6
+    lip, jaw, corner = (fap(k).id for k in ("raise_b_midlip", "open_jaw",
+                                                "stretch_l_cornerlip"))
+    assert result.targets.count(lip) == 2 and result.targets.count(jaw) == 1
+    assert result.targets.count(corner) == 1
+    scales = dict(zip(result.targets, result.scales, strict=True))
+    assert scales[corner] < 0 and scales[jaw] > 0
+    face = default_face()
+    want = face.deform(stream)
+    for frame in (0, 4, 8):
+        got = gltf.evaluate(frame)
+        for part, positions in zip(face.parts.values(), got, strict=True):
+            ids = np.sort(part.vertex_ids)
+            np.testing.assert_allclose(positions, want[frame][ids], atol=1e-4)
