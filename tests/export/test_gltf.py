@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from gltf_eval import Gltf, busy_stream
+from scipy.spatial.transform import Rotation
 
 from facelib.data import json_data
 from facelib.engine import default_face
@@ -149,3 +150,34 @@ def test_no_negative_morph_weights_a_signed_fap_is_two_targets(tmp_path):
         for part, positions in zip(face.parts.values(), got, strict=True):
             ids = np.sort(part.vertex_ids)
             np.testing.assert_allclose(positions, want[frame][ids], atol=1e-4)
+
+
+def test_each_eyelid_joint_chain_moves_the_lid_it_is_named_for(exported):
+    """Turn the joints of each ``lid_<upper|lower>_<l|r>_*`` chain alone and look at the
+    vertices that follow: the face's left is +x (feature point 3.5, the left pupil, has x > 0
+    in the face definition); the upper lid lies above the eye centre, the lower below."""
+    result, _ = exported
+    face = default_face()
+    assert face.vertices[face.feature_points["3.5"], 0] > 0  # left pupil: +x
+    gltf = Gltf(result.path)
+    names = [n.name for n in gltf.g.nodes]
+    rest = gltf.rest_matrices()
+    still = gltf.pose(rest)
+    skin_ids = np.sort(face.parts["skin"].vertex_ids)
+    skin_index = list(face.parts).index("skin")
+    for side, sign in (("l", 1), ("r", -1)):
+        centre = face.pivots[f"eye_{side}"]
+        for lid in ("upper", "lower"):
+            local = [m.copy() for m in rest]
+            for j in range(1, 9):
+                joint = names.index(f"lid_{lid}_{side}_{j}")
+                local[joint][:3, :3] = local[joint][:3, :3] @ Rotation.from_rotvec(
+                    [0.3, 0, 0]).as_matrix()
+            moved = np.linalg.norm(gltf.pose(local)[skin_index] - still[skin_index], axis=1)
+            follow = face.vertices[skin_ids[moved > 1e-5]]
+            assert len(follow) > 10, (lid, side)
+            assert np.all(np.sign(follow[:, 0]) == sign), f"lid_{lid}_{side}: wrong side"
+            above = float((follow[:, 1] > centre[1]).mean())
+            print(f"lid_{lid}_{side}: {len(follow)} vertices, {above:.2f} above the eye centre")
+            assert above > 0.75 if lid == "upper" else above < 0.25, \
+                f"lid_{lid}_{side}: {above:.2f} of its vertices above the eye centre"
