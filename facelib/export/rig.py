@@ -81,9 +81,9 @@ def build_rig(face: Face) -> Rig:
     lid_first = []
     for k, (fap_index, _, pivot, _) in enumerate(r.lids.hinges):
         lid_first.append(len(names))
-        chain = _LID_NAMES.get(int(fap_index) + 1, f"lid_{k}")
+        chain_name = _LID_NAMES.get(int(fap_index) + 1, f"lid_{k}")
         for j in range(1, FRACTIONS + 1):
-            names.append(f"{chain}_{j}")
+            names.append(f"{chain_name}_{j}")
             parents.append(head)
             rest.append(pivot)
     nv = face.n_vertices
