@@ -58,7 +58,9 @@ def _timecode(seconds: float, base: int = _TIMECODE_BASE) -> str:
 
 
 def _cell(value: float) -> str:
-    return f"{value:.6f}"
+    """Six decimals; a value that rounds to zero is written ``0.000000``, never ``-0.000000``."""
+    text = f"{value:.6f}"
+    return "0.000000" if text == "-0.000000" else text
 
 
 def write_live_link_csv(

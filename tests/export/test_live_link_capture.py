@@ -155,3 +155,15 @@ def test_nan_missing_and_extra_columns_name_line_and_column(tmp_path):
     header, rows, _ = _capture(30, 0.5)
     with pytest.raises(ArkitFormatError, match=r"bad\.csv:1: .*columns 1 and 2 .*Count"):
         read_live_link_csv(_bad(tmp_path, ["Timecode", "Count", *header[2:]], rows))
+
+
+def test_no_negative_zero_cells(tmp_path):
+    weights = np.zeros((3, 52), np.float32)
+    weights[1, 5] = -1e-9  # a solver's round-off below zero
+    angles = np.full((3, 9), -2e-7, np.float32)  # a still head, a hair below zero
+    angles[2, 0] = -0.25
+    nan = np.full(3, np.nan, np.float32)
+    text = write_live_link_csv(ArkitCurves(60.0, weights, angles, nan, nan),
+                               tmp_path / "z.csv").read_text()
+    assert "-0.000000" not in text
+    assert ",-0.250000," in text and text.count(",0.000000") > 100
