@@ -13,8 +13,9 @@ head and style:
 - p/b/m: the widest gap inside any bilabial span (a seal is under 0.5 mm) and the false
   closures (speaking frames with the gap under 0.5 mm more than 80 ms from any p/b/m and
   outside f/v, whose lower lip rises to the upper teeth);
-- the per-frame correlation of the gap with the speech envelope (the RMS of the audio over
-  40 ms centred on each frame), per sentence and its mean.
+- the per-frame correlation of the mouth opening (the gap, 0 where the lips touch or press)
+  with the speech envelope (the RMS of the audio over 40 ms centred on each frame), per
+  sentence and its mean.
 
     PYTHONPATH=. .venv/bin/python benchmarks/visemes_legibility.py [--heads default,cartoon,soma]
         [--styles normal,mumble,emphatic]
@@ -119,7 +120,8 @@ def measure(face, anims) -> dict[str, object]:
         near = frames_in(spans, {"PP"}, fps, n, pad_ms=NEAR_BILABIAL_MS) | frames_in(
             spans, {"FF"}, fps, n)
         false += int(((gap < SEAL_MM) & speaking & ~near).sum())
-        corr.append(float(np.corrcoef(gap, envelope(anim, n))[0, 1]))
+        opening = np.maximum(gap, 0.0)  # pressed lips are as shut as touching ones
+        corr.append(float(np.corrcoef(opening, envelope(anim, n))[0, 1]))
     gap_all, jaw_all = np.concatenate(gaps), np.concatenate(jaws)
     return {"gap_p50": np.percentile(gap_all, 50), "gap_p95": np.percentile(gap_all, 95),
             "open_peak_min": min(peaks), "open_peak_median": float(np.median(peaks)),

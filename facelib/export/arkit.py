@@ -6,7 +6,9 @@ the weights ``w`` in [0, 1] minimise ``|B w - d|`` (bounded least squares, scipy
 ``lsq_linear``), where ``d`` is facelib's skin deformation of the frame without head and eye
 rotation, and ``B`` the targets' displacements; the fit's residual is reported. Eye-look
 weights come from the eye angles (the eyeballs are rigid joints), head and eye angles go to
-Live Link Face's extra columns (radians; signs follow FAPs 23-26 and 48-50).
+Live Link Face's extra columns (radians; signs follow FAPs 23-26 and 48-50). TongueOut moves
+no skin: it is how far the tongue tip reaches past the upper incisors (``arkit.json``), and an
+import turns it back into the tongue-tip thrust that puts the tip there.
 
 The inverse (:func:`from_arkit`) maps weights back to FAPs with one linear map per face:
 the ridge-regularised least-squares FAPs whose deformation best matches ``B w``.
@@ -107,7 +109,9 @@ class _Basis:
 
     ids: (S,) vertex ids; targets: (3S, 52) float64 displacements (metres) at weight 1;
     shape: (K,) int64 columns solved by least squares; q, r: the QR factors of
-    ``targets[:, shape]``; to_faps: (84, 52) FAP values per unit weight (import).
+    ``targets[:, shape]``; to_faps: (84, 52) FAP values per unit weight (import);
+    tongue: the tongue tip's reach past the upper incisors at rest and per unit of FAP 45
+    (metres along +z), see :func:`_tongue_reach`.
     """
 
     ids: np.ndarray
@@ -116,6 +120,7 @@ class _Basis:
     q: np.ndarray
     r: np.ndarray
     to_faps: np.ndarray
+    tongue: tuple[float, float]
 
 
 def _load_targets(face: Face) -> tuple[np.ndarray, np.ndarray]:
@@ -180,7 +185,30 @@ def _make_basis(face: Face) -> _Basis:
     to_faps = np.zeros((N_FAPS, targets.shape[1]))
     to_faps[faps - 1] = solved
     to_faps[:, [k for k, s in enumerate(_table()[2]) if s != "shape"]] = 0.0
-    return _Basis(ids, targets, shape, q, r, to_faps)
+    return _Basis(ids, targets, shape, q, r, to_faps, _tongue_reach(face))
+
+
+_TONGUE_TIP = "6.1"
+_THRUST = 45  # thrust_tongue_tip
+
+
+def _tongue_reach(face: Face) -> tuple[float, float]:
+    """How far (metres, +z) the tongue tip lies past the front of the upper incisors at
+    rest (negative: behind them), and how far it moves forward per unit of FAP 45."""
+    tip = face.feature_points[_TONGUE_TIP]
+    front = float(np.max(face.vertices[face.parts["teeth_upper"].vertex_ids, 2]))
+    step = np.zeros(N_FAPS, np.float32)
+    step[_THRUST - 1] = 1000.0
+    per_unit = float(face.deform_frame(step)[tip, 2] - face.vertices[tip, 2]) / 1000.0
+    return float(face.vertices[tip, 2]) - front, per_unit
+
+
+def _tongue_out(moved_tip_z: np.ndarray, face: Face, reach: tuple[float, float]) -> np.ndarray:
+    """``(n,)`` TongueOut weights from the deformed tongue tip's ``z`` (metres)."""
+    rest, _ = reach
+    past = moved_tip_z - face.vertices[face.feature_points[_TONGUE_TIP], 2] + rest
+    full = float(data.json_data("export/arkit.json")["tongue_out_reach_m"])
+    return np.clip(past / full, 0.0, 1.0)
 
 
 @cache
@@ -227,9 +255,12 @@ def to_arkit(source: Source, *, face: Face | None = None) -> ArkitCurves:
             angles[:, k] = stream.values[:, j - 1] * au
     local = np.array(stream.values, np.float32)
     local[:, [j - 1 for j in _RIGID_FAPS]] = 0.0
-    moved = face.deform(FapStream(stream.fps, local, stream.mask))[:, basis.ids]
+    whole = face.deform(FapStream(stream.fps, local, stream.mask))
+    moved = whole[:, basis.ids]
     d = (moved - face.vertices[basis.ids]).reshape(stream.n_frames, -1).astype(np.float64)
     weights = _eye_look(angles)
+    weights[:, arkit_names().index("TongueOut")] = _tongue_out(
+        whole[:, face.feature_points[_TONGUE_TIP], 2], face, basis.tongue)
     residual = np.zeros(stream.n_frames, np.float32)
     relative = np.zeros(stream.n_frames, np.float32)
     projected = d @ basis.q  # (n, K)
@@ -259,6 +290,12 @@ def from_arkit(curves: ArkitCurves, *, face: Face | None = None) -> FapStream:
     for k, j in enumerate(_ANGLE_FAPS):
         if j:
             values[:, j - 1] = curves.angles[:, k] / au
+    out = curves.weights[:, arkit_names().index("TongueOut")].astype(np.float64)
+    rest, per_unit = basis.tongue
+    if per_unit > 0:
+        full = float(data.json_data("export/arkit.json")["tongue_out_reach_m"])
+        thrust = np.where(out > 0, (out * full - rest) / per_unit, 0.0)
+        values[:, _THRUST - 1] = np.maximum(thrust, 0.0)
     mask = np.zeros(values.shape, bool)
     mask[:, 2:N_STANDARD_FAPS] = True
     values[:, N_STANDARD_FAPS:] = 0.0

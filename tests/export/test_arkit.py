@@ -156,3 +156,24 @@ def test_bad_files_and_faces(tmp_path):
         neck=(np.zeros(3), np.array([0.0, 1.0, 0.0]), 0.04))
     with pytest.raises(FaceModelError, match="default head"):
         to_arkit(FapStream.zeros(2, fps=25), face=other)
+
+
+def test_tongue_out_follows_the_tongue_tip_and_comes_back():
+    """TongueOut moves no skin, so it is read from the tongue: 0 with the tip behind the
+    teeth (DD), most of the way out on a /th/, and an import puts the tip back there."""
+    from facelib.visemes import viseme_id, viseme_targets
+
+    targets = viseme_targets()
+    frames = np.stack([np.zeros(84, np.float32), targets[viseme_id("DD")],
+                       targets[viseme_id("TH")], 0.5 * targets[viseme_id("TH")]])
+    stream = FapStream(25, frames)
+    curves = to_arkit(stream)
+    out = curves.weights[:, arkit_names().index("TongueOut")]
+    assert out[0] == 0 and out[1] == 0
+    assert 0.5 < out[2] <= 1 and 0 < out[3] < out[2]
+    face = default_face()
+    tip = face.feature_points["6.1"]
+    back = face.deform(from_arkit(curves))[:, tip, 2]
+    sent = face.deform(stream)[:, tip, 2]
+    # within 2.5 mm: the jaw, which carries the tongue, comes back from the lossy ARKit fit
+    np.testing.assert_allclose(back[2:], sent[2:], atol=2.5e-3)
