@@ -12,10 +12,11 @@ installed package has it; a first round warms it and is not counted.
 
 Run: ``PYTHONPATH=. python benchmarks/import_time.py [--rounds 15] [--before DIR]``.
 
-Measured (issue 30, item 6; shared 2-core Xeon, load 7, ``--rounds 5 --before`` main):
-before, ``import facelib`` 1.80 s = 37 x bare, ``facelib --help`` 2.14 s = 44 x bare; after
-(no ``scipy.signal``, the engine loaded on first use), 0.34 s = 8.1 x and 0.37 s = 8.8 x.
-numpy alone is about 4 x bare on this machine.
+Measured (issue 30, item 6; shared 2-core Xeon, load 13, ``--rounds 7 --before`` main, after
+merging main with ``cli.py`` still one module): before, ``import facelib`` 1.75 s = 41 x
+bare, ``facelib --help`` 1.82 s = 43 x bare; after (no ``scipy.signal``, no scipy at all, the
+engine loaded on first use), 0.33 s = 7.5 x and 0.35 s = 8.0 x. numpy alone is about 4 x
+bare on this machine; the rest is facelib's own modules and the standard library.
 """
 
 from __future__ import annotations
