@@ -24,7 +24,7 @@ import numpy as np
 from facelib import data
 from facelib.engine import Face, default_face
 from facelib.errors import FaceModelError, ParameterError
-from facelib.export.source import Source, resolve_source
+from facelib.export.source import Source, export_clip, face_of
 from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
@@ -246,8 +246,9 @@ def to_arkit(source: Source, *, face: Face | None = None) -> ArkitCurves:
     """
     from scipy.optimize import lsq_linear
 
-    stream = apply_high_level(resolve_source(source)[0])
-    face, basis = _basis(face)
+    clip = export_clip(source, face=face)
+    stream = apply_high_level(clip.stream)
+    face, basis = _basis(face_of(clip))
     au = face.fapu["AU"]
     angles = np.zeros((stream.n_frames, len(ANGLE_NAMES)), np.float32)
     for k, j in enumerate(_ANGLE_FAPS):

@@ -23,7 +23,7 @@ from facelib.engine import Face, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import MissingExtraError, ParameterError
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
-from facelib.export.source import Source, resolve_source
+from facelib.export.source import Source, export_clip, face_of
 from facelib.mpeg4.tables import fap
 
 __all__ = ["GltfExport", "export_gltf"]
@@ -283,19 +283,21 @@ def export_gltf(
 
     Parameters
     ----------
-    source: a FapStream, or an object with ``faps`` (and optionally ``audio`` and
-        ``audio_offset``) such as ``facelib.run_fdl``'s Animation.
+    source: a FapStream, a :class:`~facelib.clip.Clip`, or an object with ``faps`` (and
+        optionally ``audio`` and ``audio_offset``) such as ``facelib.run_fdl``'s Animation.
     out: the ``.glb`` path (written atomically).
     face: the head (default: the bundled head).
-    audio: speech audio to copy beside the file (default: the source's own audio). glTF has
-        no audio: the copy is named in ``asset.extras.facelib.audio``.
+    audio: speech audio to copy beside the file (default: the source's own audio file; see
+        the audio rule of :mod:`facelib.clip`). glTF has no audio: the copy is named in
+        ``asset.extras.facelib.audio``, its start in ``audio_offset`` (seconds).
     """
     lib = _import_pygltflib()
     out = Path(out)
     if out.suffix.lower() != ".glb":
         raise ParameterError(f"export_gltf writes binary glTF: give a .glb path, not {out}")
-    stream, audio_path, offset = resolve_source(source, audio)
-    face = default_face() if face is None else face
+    clip = export_clip(source, face=face, audio=audio)
+    stream, audio_path, offset = clip.stream, clip.audio, clip.audio_offset
+    face = face_of(clip) or default_face()
     rig = build_rig(face)
     pose = pose_rig(face, rig, stream)
     rows, scales, weights = signed_targets(*morph_weights(face, stream))
