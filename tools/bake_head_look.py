@@ -49,11 +49,13 @@ POSES = {"neutral": {}, "open jaw": {"open_jaw": 700.0}}  # FAP values (FAP unit
 # yet still read against the cavity, which stays dark. The power steepens that fall.
 RELATIVE_PARTS = ("teeth_upper", "teeth_lower", "tongue")
 RELATIVE_PERCENTILE = 98.0
-# the teeth fall off faster: only the front teeth catch the light, the molars stay dim
-RELATIVE_POWER = {"teeth_upper": 2.5, "teeth_lower": 2.5, "tongue": 1.5}
+# the teeth fall off a little faster than the tongue: the front teeth catch the light, the
+# molars stay dimmer, yet every crown keeps enough to read as a tooth (with its gaps)
+RELATIVE_POWER = {"teeth_upper": 1.8, "teeth_lower": 1.8, "tongue": 1.5}
 # The tongue leaves the mouth (tongue out, FAP 43-44): its top, deep under the palate at
-# rest, must not turn black outside, so it keeps at least this much.
-RELATIVE_FLOOR = {"tongue": 0.3}
+# rest, must not turn black outside, so it keeps at least this much. The teeth keep a little
+# (the molars seen past the corners of the lips are dim, not black).
+RELATIVE_FLOOR = {"tongue": 0.3, "teeth_upper": 0.1, "teeth_lower": 0.1}
 
 
 # ----------------------------------------------------------------------------- skin tone
