@@ -122,7 +122,7 @@ TEETH = {
               Kind("first molar", 11.0, 10.5, 0.2, "molar"),
               Kind("second molar", 10.5, 10.0, 0.3, "molar")),
 }
-GAP = 0.25  # mm between neighbouring crowns, so each tooth reads on its own
+GAP = 0.15  # mm between neighbouring crowns, so each tooth reads on its own
 BACK = 1.0  # mm of arch left free behind the last molar
 ROOT_LENGTH = 4.5  # mm of root kept above the gum line (hidden in the gum)
 # posterior teeth (premolars, molars): where the slabs overlapped, both rows meet at the mean
@@ -136,7 +136,7 @@ LON = 12  # vertices round each ring of a tooth
 CROWN = 10.0
 RINGS = {
     # thin, chisel-shaped edge; flat labial face, the lingual side sloping to the edge
-    "incisor": ((0.0, 0.0, 0.0), (0.12, 0.86, 0.22), (0.9, 0.98, 0.42), (10.3, 1.0, 0.78),
+    "incisor": ((0.0, 0.0, 0.0), (0.12, 0.95, 0.22), (0.9, 0.995, 0.42), (10.3, 1.0, 0.78),
                 (10.62, 0.95, 0.97), (10.92, 0.78, 0.86), (11.25, 0.6, 0.68), (11.45, 0.0, 0.0)),
     # one pointed cusp: the crown narrows in both directions to a tip
     "canine": ((-0.2, 0.0, 0.0), (0.35, 0.34, 0.44), (1.3, 0.72, 0.72), (10.35, 0.98, 0.94),
@@ -148,7 +148,7 @@ RINGS = {
               (10.65, 0.98, 0.98), (10.95, 0.84, 0.86), (11.3, 0.68, 0.7), (11.5, 0.0, 0.0)),
 }
 # superellipse exponent of the cross-sections (2 = ellipse; more = squarer)
-SQUARENESS = {"incisor": 2.6, "canine": 2.2, "premolar": 2.3, "molar": 2.6}
+SQUARENESS = {"incisor": 3.2, "canine": 2.2, "premolar": 2.3, "molar": 2.6}
 # how far the cross-sections near the biting end shift toward the labial face (share of the
 # depth they lose), so the labial face stays flat and the lingual side slopes to the edge
 LABIAL_BIAS = {"incisor": 0.85, "canine": 0.8, "premolar": 0.0, "molar": 0.0}
@@ -162,7 +162,7 @@ GUM_OUT, GUM_IN = 0.8, 1.8
 GUM_STATIONS = 4  # stations of the gum tube per tooth
 
 # colours (sRGB 0-1)
-ENAMEL = np.array([0.90, 0.86, 0.76])  # ivory, not paper white
+ENAMEL = np.array([0.93, 0.89, 0.80])  # ivory, not paper white
 EDGE_TINT = np.array([0.95, 0.97, 1.02])  # the thin biting edge: greyer, a hint of blue
 NECK_TINT = np.array([0.98, 0.95, 0.86])  # the neck: warmer, more yellow
 TOOTH_VARIATION = 0.025  # relative lightness spread between teeth (seeded)
