@@ -163,7 +163,7 @@ GUM_STATIONS = 4  # stations of the gum tube per tooth
 
 # colours (sRGB 0-1)
 ENAMEL = np.array([0.93, 0.89, 0.80])  # ivory, not paper white
-EDGE_TINT = np.array([0.95, 0.97, 1.02])  # the thin biting edge: greyer, a hint of blue
+EDGE_TINT = np.array([0.95, 0.95, 0.96])  # the thin biting edge: a little greyer
 NECK_TINT = np.array([0.98, 0.95, 0.86])  # the neck: warmer, more yellow
 TOOTH_VARIATION = 0.025  # relative lightness spread between teeth (seeded)
 CANINE_YELLOW = 0.96  # canines are a shade yellower (their blue channel times this)
