@@ -327,16 +327,21 @@ def draw_clip(spec: DatasetSpec, index: int) -> ClipDraw:
 
 
 def clip_storyboard(spec: DatasetSpec, draw: ClipDraw) -> str:
-    """The FDL text of a clip: settings, the speech, expression and gaze cues."""
+    """The FDL text of a clip: settings, the speech, expression and gaze cues. Every name
+    and text is a Lua string literal (:func:`facelib.fdl.literals.lua_string`), so a
+    hostile name in a spec stays a name."""
+    from facelib.fdl.literals import lua_string
+
     lines = [f"-- clip {draw.index} of a facelib dataset (seed {spec.seed})",
              f"fps = {spec.fps:g}", f"seed = {draw.seed}"]
     if draw.text is not None:
-        lines.append(f"say {{ {json.dumps(draw.text)}, at = 0 }}")
+        lines.append(f"say {{ {lua_string(draw.text)}, at = 0 }}")
     for name, start, duration, intensity in draw.expressions:
-        lines.append(f'show {{ "{name}", at = {start:g}, dur = {duration:g}, '
+        lines.append(f"show {{ {lua_string(name)}, at = {start:g}, dur = {duration:g}, "
                      f"intensity = {intensity:g} }}")
-    behaviour_args = {"default": f'"{draw.mode}", 1.0, '}.get(draw.behaviour, "")
-    lines.append(f'look {{ "{draw.behaviour}", {behaviour_args}at = 0, dur = {spec.seconds:g} }}')
+    behaviour_args = {"default": f"{lua_string(draw.mode)}, 1.0, "}.get(draw.behaviour, "")
+    lines.append(f"look {{ {lua_string(draw.behaviour)}, {behaviour_args}at = 0, "
+                 f"dur = {spec.seconds:g} }}")
     return "\n".join(lines) + "\n"
 
 
