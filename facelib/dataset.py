@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from facelib.atomic import write_text_atomic
+from facelib.atomic import output_folder, write_text_atomic
 from facelib.checks import check_count, check_number, check_seed
 from facelib.errors import FacelibError, ParameterError
 from facelib.progress import ProgressCallback, progress_callback
@@ -603,8 +603,7 @@ def generate(
     from facelib.batch import default_jobs
 
     started = time.perf_counter()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
     _claim(spec, out)
     _clean_stale(out)
     todo = [i for i in range(spec.clips) if not (out / CLIP_PATTERN.format(i)).is_dir()]

@@ -25,6 +25,10 @@ AXES = {"+x": (1.0, 0.0, 0.0), "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0),
         "-y": (0.0, -1.0, 0.0), "+z": (0.0, 0.0, 1.0), "-z": (0.0, 0.0, -1.0)}
 """Axis names for a mesh's up and forward directions."""
 
+MAX_COORDINATE = 1e6
+"""Largest vertex coordinate accepted, in the file's unit (a head is about 300 in mm, 3e5
+in micrometres); beyond it distances overflow in the set-up's squares and kernels."""
+
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".off", ".stl")
 _PART_WORDS = (("tongue", r"tongue"), ("teeth", r"teeth|tooth"),
                ("eye", r"eye(?!brow|lash|lid)"))
@@ -90,6 +94,11 @@ def head_mesh(vertices: Any, triangles: Any, *, parts: Mapping[str, Any] | None 
     t = np.asarray(triangles)
     if v.ndim != 2 or v.shape[1] != 3 or len(v) < 4 or not np.all(np.isfinite(v)):
         raise FaceModelError(f"{name}: vertices must be finite (V >= 4, 3), got {v.shape}")
+    if np.abs(v).max() > MAX_COORDINATE:
+        bad = int(np.argmax(np.abs(v).max(axis=1)))
+        raise FaceModelError(f"{name}: vertex {bad} is at {v[bad].tolist()}, beyond "
+                             f"{MAX_COORDINATE:g} units from the origin in a coordinate; "
+                             "is the file's unit or an outlier wrong?")
     if t.ndim != 2 or t.shape[1] != 3 or not len(t) or t.dtype.kind not in "iu":
         raise FaceModelError(f"{name}: triangles must be integer (F, 3), got {t.dtype} {t.shape}")
     t = t.astype(np.int64)
@@ -153,6 +162,24 @@ def _trimesh() -> Any:
     return trimesh
 
 
+_PARSER_SLIPS = (IndexError, KeyError, AttributeError, TypeError, NameError, AssertionError,
+                 ZeroDivisionError)
+"""Exceptions a mesh parser raises when a file breaks its assumptions rather than to say
+what is wrong (``'attributes'``, ``list index out of range``, or no message at all)."""
+
+
+def _reason(exc: Exception, path: Path) -> str:
+    """One line saying why a mesh reader failed: its own message when it gave one, and
+    that the file is malformed, naming the format and the parser's exception, when it
+    slipped over the file or said nothing."""
+    text = " ".join(str(exc).split())[:200]
+    if text and text not in ("None", "''") and not isinstance(exc, _PARSER_SLIPS):
+        return text
+    detail = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+    return (f"the {path.suffix.lower().lstrip('.').upper()} file is malformed or uses a "
+            f"feature the reader does not support ({detail})")
+
+
 def load_head_mesh(path: str | Path, *, parts: Mapping[str, str] | None = None) -> HeadMesh:
     """Read a head mesh file (OBJ, PLY, GLB/glTF, OFF, STL) with trimesh.
 
@@ -171,7 +198,7 @@ def load_head_mesh(path: str | Path, *, parts: Mapping[str, str] | None = None) 
     try:
         scene = trimesh.load(path, force="scene", process=True)
     except Exception as exc:
-        raise FaceModelError(f"cannot read the mesh: {exc}", path=path) from exc
+        raise FaceModelError(f"cannot read the mesh: {_reason(exc, path)}", path=path) from exc
     dumped = _scene_meshes(scene)
     if not dumped:
         raise FaceModelError("the file holds no triangles", path=path)
