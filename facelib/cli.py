@@ -29,7 +29,14 @@ from typing import Any
 
 import facelib
 from facelib.errors import FacelibError, FileError
-from facelib.mpeg4 import FapStream, fap, format_fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4 import (
+    FapStream,
+    fap,
+    format_fap,
+    read_fap,
+    read_fap_file,
+    write_fap_complete,
+)
 from facelib.progress import ConsoleProgress, ProgressCallback
 
 __all__ = ["EXIT_ERROR", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_PIPE", "EXIT_TERMINATED",
@@ -305,8 +312,9 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
     if args.fap is not None:
         _check_suffix(args.fap, (".fap",), "--fap")
         stream = source if isinstance(source, FapStream) else source.faps
-        write_fap(stream, args.fap)
-        console.status(f"wrote {args.fap} ({stream.n_frames} frames, {stream.duration:.2f} s)")
+        written_faps = write_fap_complete(stream, args.fap)
+        console.status(f"wrote {' and '.join(map(str, written_faps))} ({stream.n_frames} "
+                       f"frames, {stream.duration:.2f} s)")
     written = render(source, face=_face_path(args.face), out=out, width=args.width,
                      framing=args.framing,
                      height=args.height, audio=args.audio, fps=args.fps,
@@ -764,7 +772,7 @@ def _add_export(commands: Any) -> None:
     imp.add_argument("capture", help="the Live Link Face .csv (or facelib's ARKit .json)")
     imp.add_argument("-o", "--output", required=True, help="OUT.fap, or - for stdout")
     imp.add_argument("--fps", type=float,
-                     help="timecode rate of the capture (default: read from the timecodes)")
+                     help="frame base of the timecodes (default: read; the app counts at 60)")
     imp.add_argument("--resample", type=float, help="resample to this frame rate (e.g. 25)")
     imp.add_argument("--dialect", default="standard",
                      choices=("standard", "xface", "greta", "extended"))
