@@ -909,6 +909,8 @@ def _report_setup(name: str, mesh: Any, result: Any, console: Console) -> None:
 
     face = result.face
     console.status(f"mesh:      {name} ({len(mesh.vertices)} vertices, unit {result.unit})")
+    if mesh.repairs:
+        console.status(f"repaired:  {'; '.join(mesh.repairs)}")
     if not np.allclose(result.rotation, np.eye(3)):
         console.status("oriented:  turned upright (+y up, looking along +z)")
     console.status(f"landmarks: {len(result.landmarks)}, off the surface by at most "
@@ -1009,10 +1011,23 @@ def _dispatch(run: Callable[[argparse.Namespace, Console], int], args: argparse.
         return EXIT_USAGE if isinstance(exc, UsageError) else EXIT_ERROR
 
 
+def _axis_values_joined(argv: Sequence[str]) -> list[str]:
+    """``argv`` with ``--up -y`` written ``--up=-y`` (and ``--forward`` alike): argparse
+    takes a value starting with '-' for an option of its own and refuses the documented
+    spelling otherwise."""
+    out: list[str] = []
+    for item in argv:
+        if out and out[-1] in ("--up", "--forward") and item in ("-x", "-y", "-z"):
+            out[-1] = f"{out[-1]}={item}"
+        else:
+            out.append(item)
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (see the module docstring)."""
     parser = _build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_axis_values_joined(sys.argv[1:] if argv is None else argv))
     run: Callable[[argparse.Namespace, Console], int] | None = getattr(args, "run", None)
     if run is None:
         parser.print_help()

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from facelib import data
-from facelib.atomic import atomic_path, write_text_atomic
+from facelib.atomic import atomic_path, output_folder, write_text_atomic
 from facelib.engine import Face
 from facelib.errors import FacelibError
 from facelib.export.gltf import export_gltf
@@ -54,8 +54,7 @@ def export_html(
         raise FacelibError(f"the web player is not built ({_BUNDLE} is missing): run "
                            "'make setup', or 'npm ci && npm run build' in "
                            f"{WEB_DIR}")
-    folder = Path(out_dir)
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = output_folder(out_dir)
     clip = export_clip(source, face=face, audio=audio)
     result = export_gltf(clip, folder / "face.glb")
     look = data.json_data("render_look.json")
