@@ -165,7 +165,7 @@ def test_tongue_out_follows_the_tongue_tip_and_comes_back():
 
     targets = viseme_targets()
     frames = np.stack([np.zeros(84, np.float32), targets[viseme_id("DD")],
-                       targets[viseme_id("TH")], 0.5 * targets[viseme_id("TH")]])
+                       targets[viseme_id("TH")], 0.8 * targets[viseme_id("TH")]])
     stream = FapStream(25, frames)
     curves = to_arkit(stream)
     out = curves.weights[:, arkit_names().index("TongueOut")]
