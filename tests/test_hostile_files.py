@@ -102,6 +102,35 @@ def test_temporaries_of_killed_processes_are_swept(tmp_path):
             "    t.write_text('half'); os.kill(os.getpid(), 9)\n")
     subprocess.run([sys.executable, "-c", code], check=False)
     left = [p.name for p in tmp_path.iterdir()]
-    assert len(left) == 1 and left[0].startswith(".out.")
+    assert len(left) == 1 and left[0].startswith(".facelib-tmp-")
     write_text_atomic(tmp_path / "other.fap", "x")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["other.fap"]
+
+
+def _dead_pid() -> int:
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    return int(child.stdout)
+
+
+def test_the_sweep_never_touches_a_users_files(tmp_path):
+    """Hidden files shaped like the old temporaries (``.name.<digits>.<8 chars>[.ext]``) are a
+    user's own; only names facelib made, with the check it wrote into them, are swept."""
+    dead = _dead_pid()
+    users = [".photo.2019.holidays.jpg", f".notes.{dead}.abcdefgh", f".x.{dead}.ABCD_123.txt",
+             f".facelib-tmp-{dead}-000000000000-00000000.fap",  # the shape, not the check
+             f".out.{dead}.k3j4h5g6.fap"]
+    for name in users:
+        (tmp_path / name).write_text("keep")
+    write_text_atomic(tmp_path / "out.fap", "x")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*users, "out.fap"])
+    assert all((tmp_path / name).read_text() == "keep" for name in users)
+
+
+def test_a_huge_number_in_a_hidden_name_does_not_break_writes(tmp_path):
+    names = [".a.99999999999999999999999999.abcdefgh", ".b.18446744073709551616.abcdefgh.fap"]
+    for name in names:
+        (tmp_path / name).write_text("keep")
+    write_text_atomic(tmp_path / "out.fap", "x")
+    assert (tmp_path / "out.fap").read_text() == "x"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*names, "out.fap"])
