@@ -128,16 +128,12 @@ def _emit_text(text: str, out: str, console: Console, summary: str) -> None:
 
 
 def _default_output(story: str, storyboard_output: Path | None, suffix: str) -> Path:
-    """Where a storyboard's product goes without ``-o``: its ``output`` (a relative name is
-    taken relative to the current directory), else ``STEM{suffix}`` in the current
-    directory, never the storyboard's own folder."""
+    """Where a storyboard's product goes without ``-o``: its ``output`` (the loader resolved
+    it inside the storyboard's folder, like every file a storyboard names), else
+    ``STEM{suffix}`` in the current directory."""
     if storyboard_output is None:
         return Path.cwd() / (Path(story).stem + suffix)
-    folder = Path(story).resolve().parent
-    try:
-        return Path.cwd() / storyboard_output.relative_to(folder)
-    except ValueError:
-        return storyboard_output
+    return storyboard_output
 
 
 def _face_path(face: str | None) -> Path | None:

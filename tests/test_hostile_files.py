@@ -134,3 +134,39 @@ def test_a_huge_number_in_a_hidden_name_does_not_break_writes(tmp_path):
     write_text_atomic(tmp_path / "out.fap", "x")
     assert (tmp_path / "out.fap").read_text() == "x"
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*names, "out.fap"])
+
+
+def test_a_storyboards_output_lands_in_its_own_folder(tmp_path, monkeypatch, capsys):
+    """``output = "keep.fap"`` run from another folder must not overwrite that folder's
+    ``keep.fap``: it names a file beside the storyboard, as for every other file it names."""
+    from facelib.cli import main
+
+    stories = tmp_path / "stories"
+    stories.mkdir()
+    story = stories / "story.fdl"
+    story.write_text('fps = 25\noutput = "keep.fap"\nshow { "joy", at = 0, dur = 0.2 }\n')
+    here = tmp_path / "here"
+    here.mkdir()
+    (here / "keep.fap").write_text("the caller's own file")
+    monkeypatch.chdir(here)
+    assert main(["run", str(story)]) == 0
+    assert (here / "keep.fap").read_text() == "the caller's own file"
+    assert sorted(p.name for p in here.iterdir()) == ["keep.fap"]
+    assert (stories / "keep.fap").read_text().startswith("2.1")
+    assert str(stories / "keep.fap") in capsys.readouterr().err
+
+
+def test_a_storyboard_cannot_make_folders(tmp_path, monkeypatch, capsys):
+    from facelib.cli import main
+
+    story = tmp_path / "story.fdl"
+    story.write_text('fps = 25\noutput = "deep/er/new.fap"\nshow { "joy", at = 0, dur = 0.2 }\n')
+    with pytest.raises(FdlError, match=r"folder 'deep/er' does not exist") as info:
+        fdl.load(story)
+    assert info.value.line == 2
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(story)]) == 1
+    assert "deep/er" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["story.fdl"]
+    (tmp_path / "deep" / "er").mkdir(parents=True)  # a folder that is there may be named
+    assert fdl.load(story).output == tmp_path / "deep" / "er" / "new.fap"

@@ -62,7 +62,7 @@ def test_output_suffix_must_match_the_format(tmp_path, capsys):
     assert main(["plot", str(SMALL), "-o", str(tmp_path / "x.fap")]) == 2
 
 
-def test_storyboard_output_is_honoured_relative_to_the_current_directory(
+def test_storyboard_output_is_honoured_inside_the_storyboards_folder(
         tmp_path, monkeypatch, capsys):
     story = tmp_path / "stories" / "named.fdl"
     story.parent.mkdir()
@@ -71,8 +71,8 @@ def test_storyboard_output_is_honoured_relative_to_the_current_directory(
     here.mkdir()
     monkeypatch.chdir(here)
     assert main(["run", str(story)]) == 0
-    assert (here / "named_out.fap").is_file()
-    assert not (story.parent / "named_out.fap").exists()
+    assert (story.parent / "named_out.fap").is_file()
+    assert not (here / "named_out.fap").exists()
     assert "wrote" in capsys.readouterr().err  # status to stderr, stdout stays clean
 
 
