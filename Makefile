@@ -57,7 +57,8 @@ $(MINIMAL_VENV)/.installed: pyproject.toml
 # Figures, not pass/fail: each benchmark prints what it measured.
 bench: $(VENV)/.installed
 	for b in engine_deform engine_deformers engine_setup render_speed gaze_simulate fdl_sandbox \
-		visemes_align_accuracy export_speed speech_long cli_timings dataset_throughput tracking; do \
+		visemes_align_accuracy export_speed speech_long cli_timings dataset_throughput tracking \
+		import_time curves_linear; do \
 		PYTHONPATH=. $(BIN)/python benchmarks/$$b.py || exit 1; done
 
 clean:

@@ -12,11 +12,10 @@ files::
 alignment (pocketsphinx) and plotting (matplotlib) load on first use.
 """
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from facelib import expressions, fdl, gaze, mpeg4, sync, visemes
 from facelib.animation import Animation, animate, run_fdl
-from facelib.engine import Face, load_face
 from facelib.errors import (
     DataError,
     FacelibError,
@@ -34,9 +33,14 @@ from facelib.errors import (
 )
 from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
 
+if TYPE_CHECKING:
+    from facelib.engine import Face, load_face
+
 __version__ = "0.1.0"
 
 _LAZY = {
+    "Face": "facelib.engine",
+    "load_face": "facelib.engine",
     "render": "facelib.rendering.frames",
     "render_still": "facelib.rendering.frames",
     "save_png": "facelib.rendering.frames",
@@ -57,7 +61,8 @@ _LAZY = {
 
 def __getattr__(name: str) -> Any:
     """Rendering, the viewer, plotting, the exports and face set-up import OpenGL,
-    matplotlib, pygltflib or trimesh: load them on first use."""
+    matplotlib, pygltflib or trimesh, and the engine scipy's sparse and spatial
+    modules: load them on first use."""
     if name in _LAZY:
         import importlib
 

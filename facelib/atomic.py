@@ -25,8 +25,15 @@ from pathlib import Path
 
 from facelib.errors import FileError
 
-__all__ = ["atomic_path", "check_output_path", "is_temporary", "publish", "temp_beside",
-           "write_text_atomic"]
+__all__ = [
+    "atomic_path",
+    "check_output_path",
+    "is_temporary",
+    "output_folder",
+    "publish",
+    "temp_beside",
+    "write_text_atomic",
+]
 
 _PREFIX = ".facelib-tmp-"
 _TEMP = re.compile(r"\.facelib-tmp-(?P<pid>[1-9][0-9]{0,9})-(?P<token>[0-9a-f]{12})"
@@ -73,6 +80,23 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
                 if stat.S_ISLNK(info.st_mode) else "a device or pipe")
         raise FileError(f"will not replace it: it is {kind}, not a file", path=target)
     return target
+
+
+def output_folder(path: str | os.PathLike[str]) -> Path:
+    """The folder ``path``, created with its parents if missing; FileError naming it if it
+    is empty, exists as something other than a folder (a file, a link), or cannot be made
+    (a parent is a file, no permission)."""
+    text = os.fspath(path)
+    if not str(text).strip():
+        raise FileError("the output folder is empty")
+    folder = Path(text)
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise FileError("exists and is not a folder; give a folder to write into", path=folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FileError.wrap(exc, "write", folder) from exc
+    return folder
 
 
 def _sweep(folder: Path) -> None:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeVar
 
+from facelib.atomic import output_folder
 from facelib.checks import check_count
 from facelib.errors import FacelibError, ParameterError
 from facelib.progress import ProgressCallback, progress_callback
@@ -143,7 +144,7 @@ def render_batch(
                         fps=fps, seed=seed, face=face)
     n_jobs = default_jobs() if jobs is None else check_count("jobs", jobs, low=1)
     n_jobs = min(n_jobs, max(len(planned), 1))
-    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    output_folder(out_dir)
     report = progress_callback(progress, "batch", unit="files")
     done = spawn_map(_indexed, list(enumerate(planned)), jobs=n_jobs, report=report,
                      max_tasks_per_child=8)

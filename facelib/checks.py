@@ -23,6 +23,7 @@ __all__ = [
     "check_items",
     "check_kind",
     "check_number",
+    "check_sample_rate",
     "check_seed",
     "did_you_mean",
 ]
@@ -64,6 +65,23 @@ def check_count(name: str, value: object, *, low: int = 0) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
         raise ParameterError(f"{name} must be an integer >= {low}, got {value!r}")
     return int(value)
+
+
+SAMPLE_RATES = (4000, 384_000)
+"""Audio sample rates facelib accepts (Hz): from narrow-band telephone speech to the highest
+rate of studio formats. A rate outside sizes a resampling filter or buffer by itself (a WAV
+header saying 1 Hz asked for 11.9 GiB when resampled to 16 kHz)."""
+
+
+def check_sample_rate(rate: object, *, source: str) -> int:
+    """``rate`` as an int within :data:`SAMPLE_RATES`; ``ParameterError`` naming ``source``
+    (the file, or ``"sample_rate"`` for an array) and the rate otherwise."""
+    low, high = SAMPLE_RATES
+    if (isinstance(rate, bool) or not isinstance(rate, (int, np.integer))
+            or not low <= rate <= high):
+        raise ParameterError(f"{source} has a sample rate of {rate!r} Hz, outside "
+                             f"{low}-{high} Hz")
+    return int(rate)
 
 
 def check_seed(seed: object) -> int:

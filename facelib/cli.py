@@ -29,7 +29,14 @@ from typing import Any
 
 import facelib
 from facelib.errors import FacelibError, FileError
-from facelib.mpeg4 import FapStream, fap, format_fap, read_fap, read_fap_file, write_fap
+from facelib.mpeg4 import (
+    FapStream,
+    fap,
+    format_fap,
+    read_fap,
+    read_fap_file,
+    write_fap_complete,
+)
 from facelib.progress import ConsoleProgress, ProgressCallback
 
 __all__ = ["EXIT_ERROR", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_PIPE", "EXIT_TERMINATED",
@@ -301,8 +308,9 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
     if args.fap is not None:
         _check_suffix(args.fap, (".fap",), "--fap")
         stream = source if isinstance(source, FapStream) else source.faps
-        write_fap(stream, args.fap)
-        console.status(f"wrote {args.fap} ({stream.n_frames} frames, {stream.duration:.2f} s)")
+        written_faps = write_fap_complete(stream, args.fap)
+        console.status(f"wrote {' and '.join(map(str, written_faps))} ({stream.n_frames} "
+                       f"frames, {stream.duration:.2f} s)")
     written = render(source, face=_face_path(args.face), out=out, width=args.width,
                      framing=args.framing,
                      height=args.height, audio=args.audio, fps=args.fps,
@@ -760,7 +768,7 @@ def _add_export(commands: Any) -> None:
     imp.add_argument("capture", help="the Live Link Face .csv (or facelib's ARKit .json)")
     imp.add_argument("-o", "--output", required=True, help="OUT.fap, or - for stdout")
     imp.add_argument("--fps", type=float,
-                     help="timecode rate of the capture (default: read from the timecodes)")
+                     help="frame base of the timecodes (default: read; the app counts at 60)")
     imp.add_argument("--resample", type=float, help="resample to this frame rate (e.g. 25)")
     imp.add_argument("--dialect", default="standard",
                      choices=("standard", "xface", "greta", "extended"))
@@ -897,6 +905,8 @@ def _report_setup(name: str, mesh: Any, result: Any, console: Console) -> None:
 
     face = result.face
     console.status(f"mesh:      {name} ({len(mesh.vertices)} vertices, unit {result.unit})")
+    if mesh.repairs:
+        console.status(f"repaired:  {'; '.join(mesh.repairs)}")
     if not np.allclose(result.rotation, np.eye(3)):
         console.status("oriented:  turned upright (+y up, looking along +z)")
     console.status(f"landmarks: {len(result.landmarks)}, off the surface by at most "
@@ -997,10 +1007,23 @@ def _dispatch(run: Callable[[argparse.Namespace, Console], int], args: argparse.
         return EXIT_USAGE if isinstance(exc, UsageError) else EXIT_ERROR
 
 
+def _axis_values_joined(argv: Sequence[str]) -> list[str]:
+    """``argv`` with ``--up -y`` written ``--up=-y`` (and ``--forward`` alike): argparse
+    takes a value starting with '-' for an option of its own and refuses the documented
+    spelling otherwise."""
+    out: list[str] = []
+    for item in argv:
+        if out and out[-1] in ("--up", "--forward") and item in ("-x", "-y", "-z"):
+            out[-1] = f"{out[-1]}={item}"
+        else:
+            out.append(item)
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (see the module docstring)."""
     parser = _build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_axis_values_joined(sys.argv[1:] if argv is None else argv))
     run: Callable[[argparse.Namespace, Console], int] | None = getattr(args, "run", None)
     if run is None:
         parser.print_help()

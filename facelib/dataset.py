@@ -13,7 +13,9 @@ Layout of ``OUT_DIR``::
     index.jsonl              one line per clip: id, seed, frames, its draw (written last)
     clip_000000/
         clip.fdl             the storyboard drawn for the clip (run it with facelib)
-        clip.fap             the animation's FAP stream (standard .fap)
+        clip.fap             the animation's FAP stream (standard .fap, FAP 1/2 decoded)
+        clip.extended.fap    when the clip uses extended FAPs 69-84 (the nose) or FAP 1/2:
+                             every FAP (facelib's extended dialect)
         frames/frame_NNNNNN.png, or clip.mp4 (``media``)
         frames.jsonl         per frame: time, expressions, eye behaviour, viseme, head
                              pose, and 2-D pixel positions of every feature point
@@ -40,8 +42,8 @@ from typing import Any
 
 import numpy as np
 
-from facelib.atomic import write_text_atomic
-from facelib.checks import check_count, check_fps, check_number
+from facelib.atomic import output_folder, write_text_atomic
+from facelib.checks import check_count, check_number, check_seed
 from facelib.errors import FacelibError, ParameterError
 from facelib.progress import ProgressCallback, progress_callback
 
@@ -92,24 +94,75 @@ class DatasetSpec:
     source: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
-        check_count("clips", self.clips, low=1)
-        check_count("seed", self.seed)
-        check_fps(self.fps)
-        check_number("seconds", self.seconds, low=0, low_open=True, high=3600)
+        for name, value in (("clips", self.clips), ("width", self.width),
+                            ("height", self.height)):
+            low, high = _LIMITS[name]
+            if check_count(name, value, low=int(low)) > high:
+                raise ParameterError(f"{name} must be an integer in [{low:g}, {high:g}], "
+                                     f"got {value!r}")
+        check_seed(self.seed)
+        check_number("fps", self.fps, low=_LIMITS["fps"][0], high=_LIMITS["fps"][1])
+        check_number("seconds", self.seconds, low=0, low_open=True, high=_LIMITS["seconds"][1])
         if self.media not in MEDIA:
             raise ParameterError(f"media must be one of {MEDIA}, got {self.media!r}")
-        low, high = self.expressions_per_clip
-        if not 0 <= low <= high:
-            raise ParameterError(f"expressions_per_clip must be (min, max) with 0 <= min <= "
-                                 f"max, got {self.expressions_per_clip!r}")
-        for name, pair in (("intensity", self.intensity), ("zoom", self.zoom),
-                           ("shift", self.shift), *zip(("pitch", "yaw", "roll"),
-                                                       self.head_deg, strict=True)):
-            if len(pair) != 2 or pair[0] > pair[1]:
-                raise ParameterError(f"{name} must be a range [low, high], got {pair!r}")
+        self._check_ranges()
         check_number("speech_probability", self.speech_probability, low=0, high=1)
         if not self.behaviours:
             raise ParameterError("behaviours must name at least one eye behaviour")
+        for name, words in (("expressions", self.expressions), ("behaviours", self.behaviours),
+                            ("texts", self.texts)):
+            _check_words(name, words)
+
+    def _check_ranges(self) -> None:
+        """Every ``(low, high)`` field: two numbers, ``low <= high``, inside its limits."""
+        counts = self.expressions_per_clip
+        if (len(counts) != 2 or not all(isinstance(c, int | np.integer)
+                                        and not isinstance(c, bool) for c in counts)):
+            raise ParameterError(f"expressions_per_clip must be two integers [min, max], got "
+                                 f"{counts!r}")
+        for name, pair in (("expressions_per_clip", counts), ("intensity", self.intensity),
+                           ("zoom", self.zoom), ("shift", self.shift),
+                           *zip(("pitch", "yaw", "roll"), self.head_deg, strict=True)):
+            low, high = _LIMITS[name]
+            if (len(pair) != 2 or not all(isinstance(v, int | float | np.number)
+                                          and not isinstance(v, bool) for v in pair)
+                    or not low <= pair[0] <= pair[1] <= high):
+                raise ParameterError(f"{name} must be a range [low, high] with {low:g} <= low "
+                                     f"<= high <= {high:g}, got {list(pair)!r}")
+
+
+# The limits of a spec's numbers (inclusive), each with its reason. A count or range
+# outside sizes the work by itself: clips = 10^12 or per_clip = [10^9, 10^9] ran for minutes
+# before this table.
+_LIMITS: dict[str, tuple[float, float]] = {
+    "clips": (1, 1_000_000),          # clip folders are numbered with six digits
+    "width": (8, 8192),               # the renderer's image size limits
+    "height": (8, 8192),
+    "fps": (1, 1000),                 # a storyboard's frame rate limits
+    "seconds": (0, 3600),             # an hour per clip
+    "expressions_per_clip": (0, 100),  # far more cues than a clip can show apart
+    "intensity": (0, 1),              # an FDL expression cue's intensity
+    "zoom": (0.1, 10),                # the face from a tenth to ten times its framed size
+    "shift": (-1, 1),                 # at most the face's size off the centre
+    "pitch": (-90, 90),               # head offsets in degrees: a quarter turn
+    "yaw": (-90, 90),
+    "roll": (-90, 90),
+}
+_MAX_WORDS = 10_000
+"""At most this many names or texts in one list of a spec."""
+_MAX_TEXT = 100_000
+"""Characters in one name or text (a storyboard's limit for one speech cue's text)."""
+
+
+def _check_words(name: str, words: Sequence[object]) -> None:
+    """``words`` (names or texts) as at most :data:`_MAX_WORDS` strings of at most
+    :data:`_MAX_TEXT` characters each."""
+    if len(words) > _MAX_WORDS:
+        raise ParameterError(f"{name} may hold at most {_MAX_WORDS} entries, got {len(words)}")
+    for i, word in enumerate(words):
+        if not isinstance(word, str) or not 0 < len(word) <= _MAX_TEXT:
+            raise ParameterError(f"{name}[{i}] must be a non-empty text of at most "
+                                 f"{_MAX_TEXT} characters, got {word!r:.60}")
 
 
 def _pair(value: Any, key: str, path: str) -> tuple[float, float]:
@@ -143,13 +196,23 @@ _FIELDS: dict[tuple[str, str], tuple[str, str]] = {
 }
 
 
+_MAX_SPEC_BYTES = 1024 * 1024
+"""A dataset spec file's size limit (a storyboard's)."""
+
+
 def _read_toml(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
     where = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        with Path(path).open("rb") as file:
+            data = file.read(_MAX_SPEC_BYTES + 1)
+        if len(data) > _MAX_SPEC_BYTES:
+            raise FacelibError(f"a dataset spec is at most {_MAX_SPEC_BYTES} bytes", path=where)
+        text = data.decode("utf-8")
         return tomllib.loads(text), text
     except OSError as exc:
         raise FacelibError(f"cannot read the dataset spec ({exc.strerror})", path=where) from None
+    except UnicodeDecodeError as exc:
+        raise FacelibError(f"not UTF-8 text (byte {exc.start})", path=where) from None
     except tomllib.TOMLDecodeError as exc:
         raise FacelibError(f"not valid TOML: {exc}", path=where) from None
 
@@ -168,13 +231,31 @@ def _convert(value: Any, kind: str, name: str, where: str) -> Any:
     if kind == _RANGE:
         return _pair(value, name, where)
     if kind == "counts":
-        low, high = _pair(value, name, where)
-        return int(low), int(high)
+        if not isinstance(value, list) or len(value) != 2:
+            raise FacelibError(f"{name} must be [min, max], got {value!r:.80}", path=where)
+        return tuple(value)  # checked (integers, limits) by DatasetSpec
     if kind == "names":
         if not isinstance(value, list):
-            raise FacelibError(f"{name} must be a list, got {value!r}", path=where)
-        return tuple(str(v) for v in value)
+            raise FacelibError(f"{name} must be a list, got {value!r:.80}", path=where)
+        return tuple(value)  # checked (texts, lengths) by DatasetSpec
     return value
+
+
+# DatasetSpec's field names as a spec file spells them, for its error messages
+_SPEC_KEYS = {field_name: f"{section}.{key}"
+              for (section, key), (field_name, _) in _FIELDS.items()} | {
+    "pitch": "head.pitch_deg", "yaw": "head.yaw_deg", "roll": "head.roll_deg"}
+
+
+def _spec_error(exc: ParameterError, where: str) -> FacelibError:
+    """``exc`` from DatasetSpec as a FacelibError naming ``where`` and the field as the spec
+    file spells it (``expressions.per_clip``, not ``expressions_per_clip``)."""
+    message = exc.message
+    for field_name, key in _SPEC_KEYS.items():
+        if message.startswith(field_name) and message[len(field_name)] in " [":
+            message = key + message[len(field_name):]
+            break
+    return FacelibError(message, path=where)
 
 
 def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
@@ -194,7 +275,9 @@ def load_spec(path: str | os.PathLike[str]) -> DatasetSpec:
                               strict=True))
     try:
         return DatasetSpec(**options, source=text)
-    except (ParameterError, TypeError) as exc:
+    except ParameterError as exc:
+        raise _spec_error(exc, where) from None
+    except TypeError as exc:
         raise FacelibError(str(exc), path=where) from None
 
 
@@ -246,16 +329,21 @@ def draw_clip(spec: DatasetSpec, index: int) -> ClipDraw:
 
 
 def clip_storyboard(spec: DatasetSpec, draw: ClipDraw) -> str:
-    """The FDL text of a clip: settings, the speech, expression and gaze cues."""
+    """The FDL text of a clip: settings, the speech, expression and gaze cues. Every name
+    and text is a Lua string literal (:func:`facelib.fdl.literals.lua_string`), so a
+    hostile name in a spec stays a name."""
+    from facelib.fdl.literals import lua_string
+
     lines = [f"-- clip {draw.index} of a facelib dataset (seed {spec.seed})",
              f"fps = {spec.fps:g}", f"seed = {draw.seed}"]
     if draw.text is not None:
-        lines.append(f"say {{ {json.dumps(draw.text)}, at = 0 }}")
+        lines.append(f"say {{ {lua_string(draw.text)}, at = 0 }}")
     for name, start, duration, intensity in draw.expressions:
-        lines.append(f'show {{ "{name}", at = {start:g}, dur = {duration:g}, '
+        lines.append(f"show {{ {lua_string(name)}, at = {start:g}, dur = {duration:g}, "
                      f"intensity = {intensity:g} }}")
-    behaviour_args = {"default": f'"{draw.mode}", 1.0, '}.get(draw.behaviour, "")
-    lines.append(f'look {{ "{draw.behaviour}", {behaviour_args}at = 0, dur = {spec.seconds:g} }}')
+    behaviour_args = {"default": f"{lua_string(draw.mode)}, 1.0, "}.get(draw.behaviour, "")
+    lines.append(f"look {{ {lua_string(draw.behaviour)}, {behaviour_args}at = 0, "
+                 f"dur = {spec.seconds:g} }}")
     return "\n".join(lines) + "\n"
 
 
@@ -356,7 +444,7 @@ def make_clip(spec: DatasetSpec, index: int, out_dir: str | os.PathLike[str]) ->
     ``"skipped"``. Safe to run anywhere that sees ``out_dir`` (a Dask worker)."""
     from facelib.animation import animate
     from facelib.fdl import loads
-    from facelib.mpeg4 import write_fap
+    from facelib.mpeg4 import write_fap_complete
 
     final = Path(out_dir) / CLIP_PATTERN.format(index)
     if final.is_dir():
@@ -369,7 +457,7 @@ def make_clip(spec: DatasetSpec, index: int, out_dir: str | os.PathLike[str]) ->
         stream = _with_head(animation.faps, draw.head_deg)
         stream = stream[: max(1, round(spec.seconds * spec.fps))]
         (temp / "clip.fdl").write_text(text, encoding="utf-8")
-        write_fap(stream, temp / "clip.fap", name=final.name)
+        write_fap_complete(stream, temp / "clip.fap", name=final.name)
         labels = _frame_labels(animation, stream)
         _render_clip(spec, draw, stream, temp, labels)
         (temp / "frames.jsonl").write_text(
@@ -517,8 +605,7 @@ def generate(
     from facelib.batch import default_jobs
 
     started = time.perf_counter()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
     _claim(spec, out)
     _clean_stale(out)
     todo = [i for i in range(spec.clips) if not (out / CLIP_PATTERN.format(i)).is_dir()]

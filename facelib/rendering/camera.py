@@ -3,9 +3,9 @@
 A cue names a framing of the look (``face``, ``head``, ``bust``) and a start; the camera cuts
 there, or with a duration moves from where it was to the new framing, easing in and out
 (smoothstep of the elapsed share). Every framed camera looks along -z, so a move is the
-camera position's path; the clipping planes span both ends of the move. Cues are read
-duck-typed (``framing``, ``start_ms``, ``duration_ms``) from ``source.storyboard.camera``,
-so this module needs neither the storyboard layer nor Lua.
+camera position's path; the clipping planes span both ends of the move. The cues come typed
+with the :class:`~facelib.clip.Clip` (:class:`~facelib.clip.CameraMove`), so this module
+needs neither the storyboard layer nor Lua.
 """
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ from typing import Any
 
 import numpy as np
 
+from facelib.clip import CameraMove, Clip
 from facelib.errors import ParameterError
-from facelib.mpeg4.stream import FapStream
 from facelib.rendering.scene import FaceRenderer, frame_camera, framing_points
 
-__all__ = ["CameraTrack", "camera_cues_of", "camera_of", "camera_track"]
+__all__ = ["CameraTrack", "camera_of", "camera_track"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,11 +31,6 @@ class CameraTrack:
     poses: np.ndarray
     znear: np.ndarray
     zfar: np.ndarray
-
-
-def camera_cues_of(source: object) -> tuple[Any, ...]:
-    """The camera cues of a render source (``source.storyboard.camera``), or ``()``."""
-    return tuple(getattr(getattr(source, "storyboard", None), "camera", ()) or ())
 
 
 def _framed(renderer: FaceRenderer, face: Any, framing: str | np.ndarray
@@ -50,7 +45,7 @@ def _framed(renderer: FaceRenderer, face: Any, framing: str | np.ndarray
                         scene_vertices=np.asarray(face.vertices, np.float32))
 
 
-def _targets(renderer: FaceRenderer, face: Any, cues: Sequence[Any]
+def _targets(renderer: FaceRenderer, face: Any, cues: Sequence[CameraMove]
              ) -> dict[str, tuple[np.ndarray, float, float]]:
     """The framed camera (pose, znear, zfar) of each framing the ``cues`` name;
     ParameterError, with the cue's storyboard file and line where it has them, for a
@@ -59,15 +54,15 @@ def _targets(renderer: FaceRenderer, face: Any, cues: Sequence[Any]
     for cue in cues:
         name = str(cue.framing)
         if name not in renderer.look.framings:
-            path, line = getattr(cue, "origin", None) or (None, None)
+            path, line = cue.origin or (None, None)
             raise ParameterError(f"camera cue framing {name!r} is not one of "
                                  f"{tuple(renderer.look.framings)}", path=path, line=line)
         targets.setdefault(name, _framed(renderer, face, name))
     return targets
 
 
-def camera_track(renderer: FaceRenderer, face: Any, cues: Sequence[Any], *, n_frames: int,
-                 fps: float, framing: str | np.ndarray) -> CameraTrack:
+def camera_track(renderer: FaceRenderer, face: Any, cues: Sequence[CameraMove], *,
+                 n_frames: int, fps: float, framing: str | np.ndarray) -> CameraTrack:
     """One camera per frame of an ``n_frames`` render at ``fps``: ``framing`` until the
     first cue, then each cue's cut or move (see the module docstring)."""
     start = _framed(renderer, face, framing)
@@ -95,11 +90,10 @@ def camera_track(renderer: FaceRenderer, face: Any, cues: Sequence[Any], *, n_fr
     return CameraTrack(poses, near, far)
 
 
-def camera_of(source: object, renderer: FaceRenderer, face: Any, stream: FapStream, *,
+def camera_of(clip: Clip, renderer: FaceRenderer, face: Any, *,
               framing: str | np.ndarray) -> CameraTrack | None:
-    """The camera track of ``source``'s storyboard cues over ``stream``; None without cues."""
-    cues = camera_cues_of(source)
-    if not cues:
+    """The camera track of ``clip``'s camera moves over its stream; None without moves."""
+    if not clip.camera:
         return None
-    return camera_track(renderer, face, cues, n_frames=stream.n_frames, fps=stream.fps,
+    return camera_track(renderer, face, clip.camera, n_frames=clip.n_frames, fps=clip.fps,
                         framing=framing)

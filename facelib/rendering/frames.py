@@ -1,9 +1,10 @@
 """Rendering FAP animations of a face: frames in memory, MP4 with speech, GIF, PNG stills.
 
-``render`` plays a :class:`~facelib.mpeg4.stream.FapStream` (or an animation object that
-carries one as ``.faps``, with an optional ``.audio`` path) on a face and returns or writes
-the frames; ``render_still`` renders one pose. OpenGL and pyrender load on first use, on
-the headless platform chosen by :mod:`facelib.rendering.platform`.
+``render`` plays a :class:`~facelib.mpeg4.stream.FapStream`, an animation or a
+:class:`~facelib.clip.Clip` (each made into a Clip at the entry: stream, face, audio, camera
+moves) on a face and returns or writes the frames; ``render_still`` renders one pose.
+OpenGL and pyrender load on first use, on the headless platform chosen by
+:mod:`facelib.rendering.platform`.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from facelib.clip import Clip, make_clip, resolve_face
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS
@@ -30,36 +32,21 @@ __all__ = ["face_or_default", "iter_frames", "render", "render_still", "save_png
 _CHUNK = 32  # frames deformed at once: bounds memory to 32 x V x 3 floats
 
 
-def stream_of(source: FapStream | HasFaps) -> tuple[FapStream, Path | None, float]:
-    """``(stream, audio path or None, audio offset in seconds)`` of a render source.
-
-    ``source`` is a :class:`FapStream` or an object with a ``faps`` FapStream and optional
-    ``audio`` (path) and ``audio_offset`` (seconds) attributes.
-    """
-    if isinstance(source, FapStream):
-        return source, None, 0.0
-    stream = getattr(source, "faps", None)
-    if not isinstance(stream, FapStream):
-        raise ParameterError(
-            f"render needs a FapStream or an animation with a .faps FapStream, got "
-            f"{type(source).__name__}"
-        )
-    audio = getattr(source, "audio", None)
-    return stream, None if audio is None else Path(audio), float(
-        getattr(source, "audio_offset", 0.0) or 0.0
-    )
+def stream_of(source: FapStream | HasFaps | Clip) -> tuple[FapStream, Path | None, float]:
+    """``(stream, audio path or None, audio offset in seconds)`` of a render source (see
+    :func:`facelib.clip.make_clip`; kept for callers of earlier versions)."""
+    clip = make_clip(source, storyboard_face=False)
+    return clip.stream, clip.audio, clip.audio_offset
 
 
-def speech_audio_file(source: object, path: Path) -> Path | None:
-    """Write ``source.speech_audio`` (synthesized speech: ``.samples`` ``(n,)`` float in
-    [-1, 1], ``.sample_rate`` Hz) to ``path`` as 16-bit WAV and return it; None when the
-    source has none."""
-    speech = getattr(source, "speech_audio", None)
-    if speech is None:
+def speech_audio_file(clip: Clip, path: Path) -> Path | None:
+    """Write ``clip.speech`` (synthesized speech) to ``path`` as 16-bit WAV and return it;
+    None when the clip has none."""
+    if clip.speech is None:
         return None
     import soundfile
 
-    soundfile.write(str(path), np.asarray(speech.samples), int(speech.sample_rate),
+    soundfile.write(str(path), clip.speech.samples, clip.speech.sample_rate,
                     subtype="PCM_16")
     return path
 
@@ -68,14 +55,9 @@ def face_or_default(face: Deformable | str | os.PathLike[str] | None,
                     source: object = None) -> Deformable:
     """``face``; a face definition JSON path loaded; None: the face the source's storyboard
     names (``face = "..."``), else facelib's default head."""
-    from facelib.engine import default_face, load_face
-
-    if face is None:
-        storyboard = getattr(source, "storyboard", None)
-        face = getattr(storyboard, "face", None)
-    if isinstance(face, (str, os.PathLike)):
-        return load_face(Path(face))
-    return default_face() if face is None else face
+    if face is None and source is not None:
+        return make_clip(source).face_or_default()
+    return resolve_face(face)
 
 
 def iter_frames(
@@ -102,7 +84,7 @@ def iter_frames(
 
 
 def render(
-    source: FapStream | HasFaps,
+    source: FapStream | HasFaps | Clip,
     *,
     face: Deformable | str | os.PathLike[str] | None = None,
     out: str | os.PathLike[str] | None = None,
@@ -119,8 +101,8 @@ def render(
 
     Parameters
     ----------
-    source: a :class:`FapStream`, or an animation with ``.faps`` (and optional ``.audio``,
-        ``.audio_offset``).
+    source: a :class:`FapStream`, an animation with ``.faps`` (and optional ``.audio``,
+        ``.audio_offset``, ``.speech_audio``), or a :class:`~facelib.clip.Clip`.
     face: the face to deform (``Face``-like: ``vertices``, ``triangles``, ``vertex_colors``,
         ``parts``, ``deform``) or a face definition JSON path; None takes the face the
         storyboard names (``face = "..."``), else the default head.
@@ -129,7 +111,8 @@ def render(
         single-frame source as one still.
     width, height: image size in pixels (even for ``.mp4``).
     audio: speech to mux into an ``.mp4`` (overrides ``source.audio``); it starts
-        ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0).
+        ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0):
+        the audio rule of :mod:`facelib.clip`.
     background: sRGB colour behind the face (None: the look's). framing: see FaceRenderer.
     progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
         None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
@@ -138,29 +121,29 @@ def render(
     Returns ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the
     written path. The camera frames the neutral face; storyboard camera cues move it.
     """
-    stream, source_audio, source_offset = stream_of(source)
+    own = make_clip(source, face=face)
+    clip = make_clip(own, audio=audio, audio_offset=audio_offset)
     if fps is not None:
-        stream = stream.resample(fps)
-    audio = source_audio if audio is None else Path(audio)
-    offset = source_offset if audio_offset is None else float(audio_offset)
-    face = face_or_default(face, source)
+        clip = clip.resampled(fps)
+    stream, face = clip.stream, clip.face_or_default()
     if out is not None and Path(out).suffix.lower() == ".png":
         return _one_png(face, stream, out, width=width, height=height, background=background,
                         framing=framing)
-    if out is None and audio is not None and source_audio is None:
+    if out is None and audio is not None and own.audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
     with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
-        if audio is None and out is not None and Path(out).suffix.lower() == ".mp4":
-            audio = speech_audio_file(source, Path(folder) / "speech.wav")
+        sound = clip.audio
+        if sound is None and out is not None and Path(out).suffix.lower() == ".mp4":
+            sound = speech_audio_file(clip, Path(folder) / "speech.wav")
         with FaceRenderer(face, width=width, height=height, background=background,
                           framing=framing) as renderer:
-            frames = iter_frames(renderer, face, stream, progress=progress, camera=camera_of(
-                source, renderer, face, stream, framing=framing))
+            frames = iter_frames(renderer, face, stream, progress=progress,
+                                 camera=camera_of(clip, renderer, face, framing=framing))
             if out is None:
                 return _collect(frames, stream.n_frames, renderer.height, renderer.width)
-            mp4_audio = audio if Path(out).suffix.lower() == ".mp4" else None
+            mp4_audio = sound if Path(out).suffix.lower() == ".mp4" else None
             return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
-                          audio_offset=offset)
+                          audio_offset=clip.audio_offset)
 
 
 def _collect(frames: Iterator[np.ndarray], n_frames: int, height: int, width: int

@@ -20,7 +20,7 @@ from typing import Protocol
 import numpy as np
 
 from facelib.atomic import atomic_path, publish, temp_beside
-from facelib.checks import check_fps
+from facelib.checks import check_fps, check_sample_rate
 from facelib.errors import MissingExtraError, ParameterError, RenderError
 
 __all__ = [
@@ -216,9 +216,7 @@ def _decode_audio(audio: Path, wav: Path) -> None:
         raise ParameterError(f"audio file {str(audio)!r} does not exist or is not a file")
     try:
         with soundfile.SoundFile(str(audio)) as source:
-            if not 4000 <= source.samplerate <= 384_000:
-                raise ParameterError(f"audio file {str(audio)!r} has a sample rate of "
-                                     f"{source.samplerate} Hz, outside 4000-384000 Hz")
+            check_sample_rate(source.samplerate, source=f"audio file {str(audio)!r}")
             with soundfile.SoundFile(str(wav), "w", samplerate=source.samplerate,
                                      channels=source.channels, subtype="PCM_16",
                                      format="WAV") as out:

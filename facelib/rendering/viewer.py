@@ -11,14 +11,13 @@ import os
 import sys
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from facelib.clip import Clip, make_clip
 from facelib.errors import RenderError
 from facelib.mpeg4.stream import FapStream
-from facelib.rendering.frames import face_or_default, stream_of
 from facelib.rendering.platform import import_pyrender
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer, install_program_cache
@@ -77,11 +76,12 @@ def _keys(state: Playback) -> dict[Any, Any]:
     }
 
 
-def _sound(audio: Path | None) -> Any:
-    """A pyglet player holding ``audio`` (read with soundfile, so any format it reads
-    plays), or None without audio. Without an audio device pyglet's silent driver takes
-    it, so playback and its clock run the same way, without sound."""
-    if audio is None:
+def _sound(clip: Clip) -> Any:
+    """A pyglet player holding the clip's audio (its file, read with soundfile so any
+    format it reads plays, or its synthesized speech), or None without audio. Without an
+    audio device pyglet's silent driver takes it, so playback and its clock run the same
+    way, without sound."""
+    if clip.audio is None and clip.speech is None:
         return None
     try:
         import io
@@ -89,7 +89,11 @@ def _sound(audio: Path | None) -> Any:
         import pyglet.media
         import soundfile
 
-        samples, rate = soundfile.read(str(audio), dtype="int16", always_2d=True)
+        if clip.audio is not None:
+            samples, rate = soundfile.read(str(clip.audio), dtype="int16", always_2d=True)
+        else:
+            assert clip.speech is not None
+            samples, rate = clip.speech.samples, clip.speech.sample_rate
         wav = io.BytesIO()
         soundfile.write(wav, samples, rate, format="WAV", subtype="PCM_16")
         wav.seek(0)  # pyglet decodes WAV itself; other formats would need its FFmpeg codec
@@ -102,7 +106,7 @@ def _sound(audio: Path | None) -> Any:
 
 
 def view(
-    source: FapStream | HasFaps,
+    source: FapStream | HasFaps | Clip,
     *,
     face: Deformable | str | os.PathLike[str] | None = None,
     width: int = 800,
@@ -110,14 +114,16 @@ def view(
     loop: bool = False,
     sound: bool = True,
 ) -> None:
-    """Open a window that plays ``source`` (FapStream or animation with ``.faps``) on ``face``.
+    """Open a window that plays ``source`` (FapStream, animation with ``.faps``, or Clip) on
+    ``face`` (None: the clip's, the storyboard's, else the bundled head).
 
     Frames follow the wall clock (frames are skipped, never slowed, when rendering lags);
     the mouse orbits and zooms as in pyrender's viewer. Space pauses and resumes, the left
     and right arrows step one frame (up/down: ten), q closes. With ``sound`` the speech
-    audio of an animation plays in sync through pyglet where an audio device exists
-    (silently otherwise); it stops on pause. The window closes at the end unless ``loop``,
-    which replays until it is closed. Blocks until then.
+    audio of an animation (its file or its synthesized speech) plays in sync through
+    pyglet where an audio device exists (silently otherwise); it stops on pause. The
+    window closes at the end unless ``loop``, which replays until it is closed. Blocks
+    until then.
     """
     if not has_display():
         raise RenderError(
@@ -132,8 +138,8 @@ def view(
             "this process already rendered offscreen (PyOpenGL is bound to "
             f"{os.environ['PYOPENGL_PLATFORM']!r}); open the viewer in a fresh process"
         )
-    stream, audio, offset = stream_of(source)
-    face = face_or_default(face, source)
+    clip = make_clip(source, face=face)
+    stream, face, offset = clip.stream, clip.face_or_default(), clip.audio_offset
     pr = import_pyrender(offscreen=False)
     scene = FaceRenderer(face, width=width, height=height, mesh_update="swap", offscreen=False)
     state = Playback(stream.fps, stream.n_frames)
@@ -150,7 +156,7 @@ def view(
     # property takes pyglet key symbols (arrows included)
     viewer.registered_keys = {**viewer.registered_keys, **_keys(state)}
     frames = np.asarray(face.deform(stream), np.float32) if stream.n_frames else None
-    player = _sound(audio) if sound else None
+    player = _sound(clip) if sound else None
     try:
         while frames is not None and viewer.is_active:
             _play_once(viewer, scene, frames, state, player=player, offset=offset)

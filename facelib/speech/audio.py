@@ -7,7 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.errors import SpeechError
+from facelib.checks import check_sample_rate
+from facelib.errors import ParameterError, SpeechError
 
 __all__ = ["ALIGN_RATE", "SILENCE_PEAK", "load_speech", "to_pcm16"]
 
@@ -25,24 +26,17 @@ def load_speech(
     ``audio`` is a file in any format, rate and channel count soundfile reads, or an array
     ``(n,)`` / ``(n, channels)`` with ``sample_rate``. Channels are averaged, the rate is
     converted with a polyphase filter. Raises :class:`SpeechError` naming the file if it is
-    unreadable, empty or silent.
+    unreadable, empty or silent, or if its sample rate is outside
+    :data:`facelib.checks.SAMPLE_RATES` (checked before any sample is read or resampled).
     """
     name = "<array>"
     if isinstance(audio, np.ndarray):
-        if sample_rate is None or sample_rate <= 0:
-            raise SpeechError(f"an audio array needs a positive sample_rate, got {sample_rate!r}")
-        data, rate = np.asarray(audio, dtype=np.float64), int(sample_rate)
+        if sample_rate is None:
+            raise SpeechError("an audio array needs a sample_rate, got None")
+        data, rate = np.asarray(audio, dtype=np.float64), _rate(sample_rate, "sample_rate")
     else:
-        import soundfile
-
-        path = Path(audio)
-        name = str(path)
-        if not path.is_file():
-            raise SpeechError("speech audio file not found", path=path)
-        try:
-            data, rate = soundfile.read(str(path), dtype="float64", always_2d=False)
-        except (soundfile.LibsndfileError, RuntimeError, TypeError) as exc:
-            raise SpeechError(f"cannot read speech audio: {exc}", path=path) from exc
+        data, rate = _read_file(Path(audio))
+        name = str(audio)
     if data.ndim == 2:
         data = data.mean(axis=1)
     if data.ndim != 1 or data.size == 0:
@@ -62,6 +56,30 @@ def load_speech(
     if data.size < ALIGN_RATE // 10:
         raise SpeechError(f"speech audio {name} is too short ({data.size / ALIGN_RATE:.3f} s)")
     return np.clip(data, -1.0, 1.0).astype(np.float32)
+
+
+def _rate(rate: object, source: str) -> int:
+    """``rate`` checked by :func:`~facelib.checks.check_sample_rate`, as a SpeechError."""
+    try:
+        return check_sample_rate(rate, source=source)
+    except ParameterError as exc:
+        raise SpeechError(exc.message) from None
+
+
+def _read_file(path: Path) -> tuple[np.ndarray, int]:
+    """The samples ``(n,)`` or ``(n, channels)`` float64 and the rate of the sound file
+    ``path``; the rate is checked from the header before any sample is read."""
+    import soundfile
+
+    if not path.is_file():
+        raise SpeechError("speech audio file not found", path=path)
+    try:
+        with soundfile.SoundFile(str(path)) as source:
+            rate = _rate(source.samplerate, f"speech audio {path}")
+            data = source.read(dtype="float64", always_2d=False)
+    except (soundfile.LibsndfileError, RuntimeError, TypeError) as exc:
+        raise SpeechError(f"cannot read speech audio: {exc}", path=path) from exc
+    return data, rate
 
 
 def to_pcm16(samples: np.ndarray, *, pad_ms: int, seed: int = 0) -> bytes:

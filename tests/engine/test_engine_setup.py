@@ -72,7 +72,7 @@ def test_mesh_files_load_with_their_parts(tmp_path: Path, source) -> None:  # ty
     assert {k: v.size for k, v in mesh.parts.items()} == {
         k: source.parts[k].vertex_ids.size for k in PART_NAMES}
     result = set_up_face(mesh, landmarks=_skin_marks(source, points=True), source=source)
-    assert result.carried == ()
+    assert result.carried == ("lashes",)  # lashes always come from the source
     eye = result.face.parts["eye_l"].vertex_ids
     assert np.allclose(result.face.vertices[eye].mean(axis=0), source.vertices[
         source.parts["eye_l"].vertex_ids].mean(axis=0), atol=1e-6)
@@ -126,9 +126,13 @@ def test_bad_meshes(source, tmp_path: Path) -> None:  # type: ignore[no-untyped-
     flipped[:10] = flipped[:10, ::-1]
     with pytest.raises(FaceModelError, match="not wound consistently"):
         head_mesh(verts, flipped)
-    soup = verts[tris].reshape(-1, 3)
+    soup = verts[tris].reshape(-1, 3)  # an unwelded triangle soup is welded, with a note
+    welded = head_mesh(soup, np.arange(len(soup)).reshape(-1, 3))
+    assert len(welded.vertices) == len(np.unique(verts[np.unique(tris)], axis=0))
+    assert welded.repairs == (f"merged {len(soup) - len(welded.vertices)} duplicate vertices",)
+    apart = soup + np.arange(len(soup))[:, None] * 1e-3  # no two vertices at one place
     with pytest.raises(FaceModelError, match="triangle soup"):
-        head_mesh(soup, np.arange(len(soup)).reshape(-1, 3))
+        head_mesh(apart, np.arange(len(apart)).reshape(-1, 3))
     with pytest.raises(FaceModelError, match="unknown mesh format"):
         load_head_mesh(tmp_path / "head.fbx")
     broken = tmp_path / "broken.ply"
@@ -142,7 +146,7 @@ def test_cli_face_setup_then_render(tmp_path: Path, capsys) -> None:  # type: ig
     assert main(["face", "setup", str(HEADS / "cartoon_head.obj"), "--landmarks",
                  str(HEADS / "cartoon_landmarks.json"), "-o", str(out)]) == 0
     text = capsys.readouterr().err  # status lines go to stderr
-    assert "eye_l, eye_r, teeth_upper, teeth_lower, tongue warped into place" in text
+    assert "eye_l, eye_r, teeth_upper, teeth_lower, tongue, lashes warped into place" in text
     face = load_face(out / "face.json")
     assert face.n_vertices > load_head_mesh(HEADS / "cartoon_head.obj").vertices.shape[0]
     story = tmp_path / "story.fdl"

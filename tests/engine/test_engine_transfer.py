@@ -205,7 +205,7 @@ def soma(source, tmp_path_factory):  # type: ignore[no-untyped-def]
 
 def test_x5_soma_head_loads_and_places_held_out_points(soma, source) -> None:  # type: ignore[no-untyped-def]
     result, face, marks = soma
-    assert result.carried == PART_NAMES[1:]
+    assert result.carried == (*PART_NAMES[1:], "lashes")
     assert len(result.landmarks) == 24
     assert np.array_equal(face.vertices, result.face.vertices)
     err = np.array([np.linalg.norm(face.vertices[face.feature_points[k]] - marks[k])

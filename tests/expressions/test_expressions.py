@@ -111,3 +111,50 @@ def test_default_ramps_come_from_the_data_file():
 
     assert default_ramp_ms(10_000) == 400
     assert default_ramp_ms(1000) == 250  # a quarter of a short cue
+
+
+def _dense_animate(cues, *, fps, n_frames, importance, easing):  # type: ignore[no-untyped-def]
+    """The expression track as it was computed before issue 30: every cue's envelope over
+    every frame, added into full arrays (quadratic time; the reference for the span form)."""
+    from facelib.expressions.curves import _ramps
+
+    library = default_library()
+    times = np.arange(n_frames) * (1000.0 / fps)
+    total, strength, weight = (np.zeros((n_frames, 84)) for _ in range(3))
+    for cue in cues:
+        expression = library.get(cue.name)
+        ramp_in, ramp_out = _ramps(cue)
+        e = envelope(times, start_ms=cue.start_ms, duration_ms=cue.duration_ms,
+                     ramp_in_ms=ramp_in, ramp_out_ms=ramp_out, easing=easing)[:, None]
+        total += e * cue.intensity * expression.values
+        strength += e * expression.mask
+        weight += e * expression.mask * float(importance.get(expression.name, 1.0))
+    return ((total / np.maximum(strength, 1.0)).astype(np.float32),
+            np.clip(weight, 0.0, 1.0).astype(np.float32))
+
+
+@pytest.mark.parametrize("easing", ["linear", "smooth"])
+def test_each_cue_on_its_own_span_is_bit_identical_to_the_dense_sum(easing):
+    # issue 30: each cue works on the frames of its span only; the track must not change
+    rng = np.random.default_rng(30)
+    names = sorted(default_library().names)
+    cues = []
+    for _ in range(60):
+        duration = int(rng.integers(1, 3000))
+        ramps = (None, None) if rng.random() < 0.4 else (
+            int(rng.integers(0, duration // 2 + 1)), int(rng.integers(0, duration // 2 + 1)))
+        cues.append(ExpressionCue(str(rng.choice(names)), int(rng.integers(0, 24_000)),
+                                  duration, intensity=float(rng.uniform(-0.5, 1.5)),
+                                  ramp_in_ms=ramps[0], ramp_out_ms=ramps[1]))
+    cues.append(ExpressionCue(names[0], 40, 40, ramp_in_ms=0, ramp_out_ms=0))  # frame-exact
+    cues.append(ExpressionCue(names[1], 19_990, 5000))  # past the last frame
+    importance = {names[0]: 0.5, names[2]: 0.25}
+    for fps in (25.0, 29.97):
+        n_frames = int(20 * fps)
+        track = animate(cues, fps=fps, n_frames=n_frames, importance=importance,
+                        easing=easing)
+        values, weight = _dense_animate(cues, fps=fps, n_frames=n_frames,
+                                        importance=importance, easing=easing)
+        assert np.array_equal(track.values, values)
+        assert np.array_equal(track.weight, weight)
+        assert np.array_equal(np.signbit(track.values), np.signbit(values))

@@ -71,3 +71,18 @@ def test_a_saccade_resets_the_hold_and_the_offsets_stay_inside_the_disk():
                                still=np.ones(20000))
     assert np.hypot(*motion.offsets.T).max() <= p["max_deg"] + 1e-12
     assert 1.2 <= len(motion.microsaccades) / (20000 / FPS) <= 1.8
+
+
+def test_drift_filter_matches_scipy_lfilter_bit_for_bit():
+    # the drift's recursive filter is written out so import facelib need not load
+    # scipy.signal (issue 30); it must be the same arithmetic
+    from scipy.signal import lfilter
+
+    from facelib.gaze.fixation import _recursive
+
+    noise = np.random.default_rng(3).standard_normal((5000, 2)) * 0.3
+    noise[7] = [-0.0, 0.0]
+    for a in (0.0, 0.2, float(np.exp(-0.4 / 25.0)), 0.999999):
+        expected = lfilter([1.0], [1.0, -a], noise, axis=0)
+        assert np.array_equal(_recursive(noise, a), expected)
+        assert np.array_equal(np.signbit(_recursive(noise, a)), np.signbit(expected))

@@ -75,9 +75,10 @@ import numpy as np
 from pathlib import Path
 from types import SimpleNamespace
 import facelib
+from facelib.clip import Clip
 from facelib.rendering import viewer
 audio = Path({str(ROOT / "examples" / "hello" / "hello.flac")!r})
-player = viewer._sound(audio)
+player = viewer._sound(Clip(facelib.FapStream(25, np.zeros((2, 84), np.float32)), audio=audio))
 print("player", type(player).__name__, round(player.source.duration, 2))
 clip = SimpleNamespace(faps=facelib.FapStream(25, np.zeros((20, 84), np.float32)),
                        audio=audio, audio_offset=0.2)

@@ -88,42 +88,75 @@ local function safe_pcall(f, ...)
   return check_fatal(raw_pcall(f, ...))
 end
 
+-- Every table and function a chunk can reach gets a birth number in creation order: the
+-- chunk's constructors are marked (__fdl_at for tables, __fdl_fn for functions), the
+-- libraries are numbered when the environment is built, and anything else on first sight.
+-- pairs orders keys that have no value order by it, and tostring prints it instead of an
+-- address, so neither leaks the allocator's addresses into a storyboard.
+local birth = raw_setmetatable({}, { __mode = "k" })
+local births = 0
+
+local function born(v)
+  local n = birth[v]
+  if n == nil then
+    births = births + 1
+    n = births
+    birth[v] = n
+  end
+  return n
+end
+
+local function renumber(v)
+  births = births + 1
+  birth[v] = births
+end
+
+local OBJECT = { table = true, ["function"] = true, userdata = true, thread = true }
+
+local function safe_tostring(v)
+  local kind = raw_type(v)
+  if OBJECT[kind] then return kind .. ": #" .. born(v) end
+  return raw_tostring(v)
+end
+
 local function safe_print(...)
   local n = raw_select("#", ...)
   local parts = {}
-  for i = 1, n do parts[i] = raw_tostring((raw_select(i, ...))) end
+  for i = 1, n do parts[i] = safe_tostring((raw_select(i, ...))) end
   local text = table_concat(parts, "\t")
   charge(#text)
   host_log(text)
 end
 
--- pairs in a stable order, whatever the string hash seed of this Lua state: numbers first
--- (ascending), then strings (byte order), then booleans (false first); keys of other types
--- (tables, functions) last, in the table's own order. The snapshot of keys is taken when the
--- loop starts, so assigning to existing fields while iterating is safe, as with pairs.
+-- pairs in a stable order, whatever the string hash seed of this Lua state and whatever
+-- the addresses of its objects: numbers first (ascending), then strings (byte order), then
+-- booleans (false first), then tables and functions in the order they were made. The
+-- snapshot of keys is taken when the loop starts, so assigning to existing fields while
+-- iterating is safe, as with pairs.
 local KEY_RANK = { number = 1, string = 2, boolean = 3 }
 local function key_before(a, b)
   local ta, tb = raw_type(a), raw_type(b)
-  if ta ~= tb then return KEY_RANK[ta] < KEY_RANK[tb] end
+  local ra, rb = KEY_RANK[ta] or 4, KEY_RANK[tb] or 4
+  if ra ~= rb then return ra < rb end
+  if ra == 4 then return born(a) < born(b) end
   if ta == "boolean" then return (not a) and b end
   return a < b
 end
 
 local function stable_pairs(t)
-  local sortable, others = {}, {}
-  for k in raw_pairs(t) do
-    if KEY_RANK[raw_type(k)] then sortable[#sortable + 1] = k else others[#others + 1] = k end
-  end
-  charge(#sortable * 20)
-  table_sort(sortable, key_before)
-  for _, k in raw_ipairs(others) do sortable[#sortable + 1] = k end
+  local keys = {}
+  for k in raw_pairs(t) do keys[#keys + 1] = k end
+  charge(#keys * 20)
+  table_sort(keys, key_before)
   local i = 0
-  return function()
+  local function step()
     i = i + 1
-    local k = sortable[i]
+    local k = keys[i]
     if k == nil then return nil end
     return k, t[k]
-  end, t, nil
+  end
+  born(step)
+  return step, t, nil
 end
 
 local function copy(t, drop)
@@ -156,6 +189,23 @@ local function guard_pattern(fn, name, pattern_arg)
   end
 end
 
+-- string.format without addresses: %p (an object's or a string's address) is refused and
+-- tables and functions given to %s are shown as tostring shows them.
+local function safe_format(fmt, ...)
+  if raw_type(fmt) == "string" then
+    local bare = str_gsub(fmt, "%%%%", "")
+    if str_find(bare, "%%[-+ #0]*%d*%.?%d*p") then
+      raw_error("string.format: %p (an address) is not available in the sandbox", 2)
+    end
+  end
+  local n = raw_select("#", ...)
+  local args = { ... }
+  for i = 1, n do
+    if OBJECT[raw_type(args[i])] then args[i] = safe_tostring(args[i]) end
+  end
+  return string_lib.format(fmt, table_lib.unpack(args, 1, n))
+end
+
 local function guarded_string()
   local s = copy(string_lib, { dump = true })
   s.find = guard_pattern(string_lib.find, "find", true)
@@ -174,9 +224,16 @@ local function guarded_string()
     end
     return rep(str, count, sep)
   end
-  for _, name in raw_ipairs({ "format", "upper", "lower", "reverse", "sub", "char", "byte",
+  for _, name in raw_ipairs({ "upper", "lower", "reverse", "sub", "char", "byte",
                               "pack", "unpack" }) do
     s[name] = charged_after(string_lib[name])
+  end
+  s.format = charged_after(safe_format)
+  local gmatch = s.gmatch
+  s.gmatch = function(...)
+    local iterator = gmatch(...)
+    born(iterator)
+    return iterator
   end
   return s
 end
@@ -200,6 +257,12 @@ local function guarded_table()
     if jj >= ii then charge(jj - ii + 1) end
     return unpack(list, i, j)
   end
+  local pack = table_lib.pack
+  t.pack = function(...)
+    local packed = pack(...)
+    born(packed)
+    return packed
+  end
   local sort = table_lib.sort
   t.sort = function(list, cmp)
     local n = #list
@@ -219,6 +282,30 @@ local function recorder(calls, kind)
   end
 end
 
+-- Birth numbers for what the environment holds, in name order (libraries and their
+-- functions), and for the static iterators ipairs and utf8.codes return.
+local function sorted_names(t)
+  local names = {}
+  for k in raw_pairs(t) do names[#names + 1] = k end
+  table_sort(names)
+  return names
+end
+
+local function number_env(env)
+  renumber(env)
+  for _, name in raw_ipairs(sorted_names(env)) do
+    local value = env[name]
+    renumber(value)
+    if raw_type(value) == "table" then
+      for _, inner in raw_ipairs(sorted_names(value)) do
+        if OBJECT[raw_type(value[inner])] then renumber(value[inner]) end
+      end
+    end
+  end
+  renumber((raw_ipairs({})))
+  renumber((utf8_lib.codes("")))
+end
+
 local function new_env(api_names, calls)
   local s = guarded_string()
   string_mt.__index = s
@@ -231,7 +318,7 @@ local function new_env(api_names, calls)
     ipairs = raw_ipairs,
     select = raw_select,
     type = raw_type,
-    tostring = raw_tostring,
+    tostring = safe_tostring,
     tonumber = raw_tonumber,
     error = raw_error,
     pcall = safe_pcall,
@@ -239,6 +326,7 @@ local function new_env(api_names, calls)
     print = safe_print,
   }
   for _, name in raw_ipairs(api_names) do env[name] = recorder(calls, name) end
+  number_env(env)
   return env
 end
 
@@ -260,7 +348,8 @@ end
 
 -- run(original, marked, chunkname, budget, seed, api_names, seconds)
 --   original: the user's text, compiled once to report its own syntax errors.
---   marked: the same text with table constructors wrapped in __fdl_at(line, {...}).
+--   marked: the same text with table constructors wrapped in __fdl_at(line, {...}) and
+--   function constructors in __fdl_fn(function ... end).
 -- Returns true, env, lines, calls, used  or  false, kind, message, line, used
 -- with kind one of "syntax", "runtime", "instructions", "memory".
 local function run(original, marked, chunkname, budget, seed, api_names, seconds)
@@ -268,12 +357,20 @@ local function run(original, marked, chunkname, budget, seed, api_names, seconds
   if not f then return false, "syntax", err, -1, 0 end
   f = nil
   local calls = {}
-  local env = new_env(api_names, calls)
   local lines = raw_setmetatable({}, { __mode = "k" })
+  births = 0
+  local env = new_env(api_names, calls)
   local function at(line, t)
     if raw_type(t) == "table" and raw_type(line) == "number" then lines[t] = line end
+    born(t)
     return t
   end
+  local function fn(f)
+    born(f)
+    return f
+  end
+  renumber(at)
+  renumber(fn)
   f, err = raw_load(marked, chunkname, "t", env)
   if not f then return false, "syntax", err, -1, 0 end
   math_randomseed(seed)
@@ -281,7 +378,7 @@ local function run(original, marked, chunkname, budget, seed, api_names, seconds
   state.line, state.fatal, state.err_line = -1, false, -1
   state.deadline = host_clock() + seconds
   debug_sethook(hook, "", STEP)
-  local ok, e = raw_xpcall(f, handler, at)
+  local ok, e = raw_xpcall(f, handler, at, fn)
   debug_sethook()
   if ok then return true, env, lines, calls, state.used end
   f, env, lines, calls = nil, nil, nil, nil

@@ -1,0 +1,211 @@
+"""The one typed hand-off to every output: a :class:`Clip`.
+
+Rendering, the viewer and the exports (glTF, ARKit curves, the web player) play a Clip: a
+FAP stream, the face it plays on, the speech audio with the time it starts at, and the
+storyboard's camera moves. :func:`make_clip` makes one, once, at an output's entry, from
+what the public functions take (a :class:`~facelib.mpeg4.stream.FapStream`, an animation
+such as :func:`facelib.run_fdl`'s, or a Clip), so no output reads an animation's attributes
+by name and every output follows the same audio rule:
+
+- ``audio`` given: that file (it must exist), starting ``audio_offset`` seconds into the
+  clip, by default where the source's speech starts (0 for a FapStream);
+- else the source's own recording (``animation.audio``) at its offset;
+- else the source's synthesized speech (``animation.speech_audio``: samples, no file) at
+  its offset;
+- a FapStream has no audio.
+
+An output plays what it can carry: video muxes the file or the synthesized samples; a glTF
+and the web page copy a file (synthesized speech has none to copy); the viewer plays either.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from facelib.errors import ParameterError
+from facelib.mpeg4.stream import FapStream
+
+__all__ = ["CameraMove", "Clip", "Deformable", "Speech", "make_clip", "resolve_face"]
+
+
+@runtime_checkable
+class Deformable(Protocol):
+    """A face mesh that FAPs deform (:class:`facelib.engine.Face` is one).
+
+    ``vertices``: ``(V, 3) float32`` neutral positions; ``triangles``: ``(F, 3)`` vertex ids;
+    ``parts``: part name -> object with ``triangles``; ``vertex_colors``: ``(V, 3)`` sRGB in
+    [0, 1] or None.
+    """
+
+    @property
+    def vertices(self) -> np.ndarray: ...
+
+    @property
+    def triangles(self) -> np.ndarray: ...
+
+    @property
+    def parts(self) -> Mapping[str, Any]: ...
+
+    def deform(self, stream: FapStream) -> np.ndarray:
+        """``(n_frames, V, 3) float32`` vertex positions for every frame of ``stream``."""
+        ...
+
+    def deform_frame(self, values: np.ndarray) -> np.ndarray:
+        """``(V, 3) float32`` positions for one frame of 84 FAP values."""
+        ...
+
+
+@dataclass(frozen=True, slots=True)
+class CameraMove:
+    """A storyboard camera cue: re-frame on ``framing`` (a look's framing name) at
+    ``start_ms``, a cut when ``duration_ms`` is 0, else a move arriving ``duration_ms``
+    later. ``origin``: the cue's storyboard ``(file, line)``, or None."""
+
+    framing: str
+    start_ms: int
+    duration_ms: int = 0
+    origin: tuple[str | None, int | None] | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Speech:
+    """Synthesized speech without a file: ``samples (n,)`` float (float32 as synthesized)
+    in [-1, 1] at ``sample_rate`` Hz (a read-only view, dtype kept)."""
+
+    samples: np.ndarray
+    sample_rate: int
+
+    def __post_init__(self) -> None:
+        samples = np.asarray(self.samples).view()
+        samples.flags.writeable = False
+        object.__setattr__(self, "samples", samples)
+        object.__setattr__(self, "sample_rate", int(self.sample_rate))
+
+
+@dataclass(frozen=True, eq=False)
+class Clip:
+    """What every output plays.
+
+    stream: the FAP stream (its ``fps`` is the clip's frame rate).
+    face: the face it plays on, or None for facelib's bundled head (loaded by the output
+        that needs a mesh).
+    audio: the speech audio file, or None.
+    speech: synthesized speech samples to play when there is no ``audio`` file, or None.
+    audio_offset: seconds into the clip at which the audio (or speech) starts.
+    camera: the storyboard's camera moves, by start.
+    """
+
+    stream: FapStream
+    face: Deformable | None = None
+    audio: Path | None = None
+    speech: Speech | None = None
+    audio_offset: float = 0.0
+    camera: tuple[CameraMove, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.stream, FapStream):
+            raise ParameterError(f"a Clip's stream is a FapStream, not "
+                                 f"{type(self.stream).__name__}")
+        object.__setattr__(self, "audio", None if self.audio is None else Path(self.audio))
+        object.__setattr__(self, "audio_offset", float(self.audio_offset))
+        object.__setattr__(self, "camera", tuple(self.camera))
+
+    @property
+    def fps(self) -> float:
+        """Frames per second (the stream's)."""
+        return float(self.stream.fps)
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.stream.n_frames)
+
+    def resampled(self, fps: float) -> Clip:
+        """The clip with its stream resampled to ``fps`` (audio and camera keep their
+        times in seconds and milliseconds)."""
+        return replace(self, stream=self.stream.resample(fps))
+
+    def face_or_default(self) -> Deformable:
+        """The clip's face, or facelib's bundled head when it has none."""
+        return resolve_face(self.face)
+
+    def __repr__(self) -> str:
+        audio = f", audio={self.audio.name!r}" if self.audio is not None else ""
+        speech = ", speech=synthesized" if self.speech is not None else ""
+        return (f"Clip(frames={self.n_frames}, fps={self.fps:g}, "
+                f"face={'bundled' if self.face is None else type(self.face).__name__}"
+                f"{audio}{speech}, audio_offset={self.audio_offset:g}, "
+                f"camera={len(self.camera)})")
+
+
+FaceArg = Deformable | str | os.PathLike[str] | None
+
+
+def resolve_face(face: FaceArg) -> Deformable:
+    """``face``; a face definition JSON path loaded; None: facelib's bundled head."""
+    from facelib.engine import default_face, load_face
+
+    if isinstance(face, (str, os.PathLike)):
+        return load_face(Path(face))
+    return default_face() if face is None else face
+
+
+def make_clip(
+    source: Clip | FapStream | object,
+    *,
+    face: FaceArg = None,
+    audio: str | os.PathLike[str] | None = None,
+    audio_offset: float | None = None,
+    storyboard_face: bool = True,
+) -> Clip:
+    """The :class:`Clip` of ``source``: a Clip, a FapStream, or an animation (an object with
+    a ``faps`` FapStream and optionally ``audio``, ``audio_offset``, ``speech_audio`` and a
+    ``storyboard`` with ``face`` and ``camera``, such as :class:`facelib.Animation`).
+
+    face: the face to play on (a face-like object or a face definition JSON path, loaded);
+        None keeps a Clip's face, else takes the face the storyboard names (unless
+        ``storyboard_face`` is False), else None: the bundled head.
+    audio, audio_offset: the audio rule of the module docstring; an explicit ``audio`` must
+        be an existing file (ParameterError otherwise), as must the source's own.
+    """
+    clip = (source if isinstance(source, Clip)
+            else _from_source(source, storyboard_face=storyboard_face and face is None))
+    if face is not None:
+        clip = replace(clip, face=resolve_face(face) if isinstance(face, (str, os.PathLike))
+                       else face)
+    if audio is not None:
+        clip = replace(clip, audio=Path(audio))
+    if audio_offset is not None:
+        clip = replace(clip, audio_offset=float(audio_offset))
+    if clip.audio is not None and not clip.audio.is_file():
+        raise ParameterError(f"audio file {clip.audio} does not exist")
+    return clip
+
+
+def _from_source(source: object, *, storyboard_face: bool) -> Clip:
+    """A Clip of a FapStream or an animation (read by attribute name here, and only here)."""
+    if isinstance(source, FapStream):
+        return Clip(source)
+    stream = getattr(source, "faps", None)
+    if not isinstance(stream, FapStream):
+        raise ParameterError(f"an output needs a FapStream, a Clip or an animation with a "
+                             f".faps FapStream, not {type(source).__name__}")
+    storyboard = getattr(source, "storyboard", None)
+    named = getattr(storyboard, "face", None) if storyboard_face else None
+    own = getattr(source, "audio", None)
+    samples = getattr(source, "speech_audio", None)
+    speech = (None if samples is None
+              else Speech(np.asarray(samples.samples), int(samples.sample_rate)))
+    camera = tuple(
+        CameraMove(str(cue.framing), int(cue.start_ms), int(cue.duration_ms),
+                   getattr(cue, "origin", None))
+        for cue in (getattr(storyboard, "camera", ()) or ()))
+    return Clip(stream, face=None if named is None else resolve_face(named),
+                audio=None if own is None else Path(own), speech=speech,
+                audio_offset=float(getattr(source, "audio_offset", 0.0) or 0.0),
+                camera=camera)
