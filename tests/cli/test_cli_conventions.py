@@ -147,20 +147,21 @@ def test_a_signal_a_library_turned_into_another_error_still_exits_as_that_signal
     import argparse
     import ctypes
 
-    from facelib.cli import Console, _dispatch
+    from facelib.cli.console import Console
+    from facelib.cli.dispatch import dispatch
 
     def run(args, console):
         console.signals.received = signal.SIGTERM
         raise ctypes.ArgumentError("argument 2: Terminated: ")
 
-    assert _dispatch(run, argparse.Namespace(), Console()) == 143
+    assert dispatch(run, argparse.Namespace(), Console()) == 143
     assert capsys.readouterr().err.strip() == "facelib: terminated"
 
     def broken(args, console):
         raise ValueError("a bug, with no signal")
 
     with pytest.raises(ValueError, match="a bug"):
-        _dispatch(broken, argparse.Namespace(), Console())
+        dispatch(broken, argparse.Namespace(), Console())
 
 
 def test_exit_codes_are_documented():
