@@ -177,12 +177,10 @@ def _track(args: argparse.Namespace, console: Console) -> int:
                           brows=source.brows)
     console.status("user FAPU (pixels): " + ", ".join(f"{k}0={v * 1024:.1f}"
                                              for k, v in result.fapu.items() if k != "AU"))
-    stream = result.stream
-    if stream.fps != round(stream.fps):  # a camera's measured rate, a landmark file's
-        stream = stream.resample(max(1, round(stream.fps)))
-        if abs(result.stream.fps - stream.fps) > 1e-3 * stream.fps:  # not timestamps' noise
-            console.status(f"resampled from {result.stream.fps:.4g} to {stream.fps:g} frames "
-                           "a second: a .fap holds whole rates")
+    stream = result.stream.at_whole_rate()  # a camera's measured rate, a landmark file's
+    if abs(result.stream.fps - stream.fps) > 1e-3 * stream.fps:  # not timestamps' noise
+        console.status(f"resampled from {result.stream.fps:.4g} to {stream.fps:g} frames "
+                       "a second: a .fap holds whole rates")
     emit_text(format_fap(stream, dialect=args.dialect, name=Path(args.output).stem),
               args.output, console, f"({stream.n_frames} frames, {stream.duration:.2f} s)")
     if args.render and source.video is not None:
