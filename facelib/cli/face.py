@@ -54,7 +54,7 @@ def _write_found(found: Any, folder: Path, console: Console) -> None:
 
 
 def _face_setup(args: argparse.Namespace, console: Console) -> int:
-    from facelib.engine.headmesh import axes_rotation, load_head_mesh
+    from facelib.engine.headmesh import load_head_mesh
     from facelib.engine.setup import set_up_face
     from facelib.engine.writer import write_face
 
@@ -67,17 +67,14 @@ def _face_setup(args: argparse.Namespace, console: Console) -> int:
     parts = dict(item.split("=", 1) for item in args.part)
     mesh = load_head_mesh(args.mesh, parts=parts)
     landmarks: Any = args.landmarks
-    axes = {"up": args.up, "forward": args.forward}
     found = None
     if args.auto:
         from facelib.tracking.head_landmarks import detect_head_landmarks
 
-        if args.up is not None or args.forward is not None:  # upright before looking
-            mesh = mesh.rotated(axes_rotation(args.up or "+y", args.forward or "+z"))
-            axes = {"up": None, "forward": None}
-        found = detect_head_landmarks(mesh)
+        found = detect_head_landmarks(mesh, up=args.up, forward=args.forward)
         landmarks = found.as_json()
-    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit, **axes)
+    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit, up=args.up,
+                         forward=args.forward)
     out = write_face(result.face, Path(args.output) / "face.json", name=Path(args.mesh).stem,
                      source=f"facelib face setup {Path(args.mesh).name}")
     if found is not None:
