@@ -31,6 +31,7 @@ from facelib.errors import (
     RenderError,
     SpeechError,
     SpeechWarning,
+    facelib_warnings,
 )
 from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
 
@@ -89,6 +90,7 @@ __all__ = [
     "export_gltf",
     "export_html",
     "expressions",
+    "facelib_warnings",
     "fap",
     "fdl",
     "feature_point",

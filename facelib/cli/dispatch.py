@@ -16,7 +16,6 @@ import os
 import signal
 import sys
 import traceback
-import warnings
 from collections.abc import Callable, Iterator, Sequence
 from types import ModuleType
 
@@ -49,7 +48,7 @@ from facelib.cli.console import (
     UsageError,
 )
 from facelib.cli.options import COMMON
-from facelib.errors import FacelibError
+from facelib.errors import FacelibError, facelib_warnings
 
 # The subcommands, each a module with ``add(commands)``, in the order ``--help`` lists them.
 COMMANDS: tuple[ModuleType, ...] = (
@@ -144,11 +143,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     console = Console(quiet=getattr(args, "quiet", False), verbose=getattr(args, "verbose", False))
     if console.verbose:
         logging.basicConfig(level=logging.INFO, format="facelib: %(name)s: %(message)s")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", facelib.FacelibWarning)
+    with facelib_warnings() as caught:
         status = dispatch(run, args, console)
     for warning in caught:
-        if not console.quiet and issubclass(warning.category, facelib.FacelibWarning):
+        if not console.quiet:
             print(f"facelib: warning: {warning.message}", file=sys.stderr)
     return status
 
