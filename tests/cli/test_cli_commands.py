@@ -1,7 +1,6 @@
 """The storyboard commands: check, run, render, plot, play, align."""
 
 import importlib.util
-import warnings
 from pathlib import Path
 
 import pytest
@@ -11,13 +10,6 @@ from facelib.cli import main
 
 ROOT = Path(__file__).parents[2]
 SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
-
-
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        yield
 
 
 def test_check_lists_cues_with_lines(capsys):
