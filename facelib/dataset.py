@@ -13,7 +13,9 @@ Layout of ``OUT_DIR``::
     index.jsonl              one line per clip: id, seed, frames, its draw (written last)
     clip_000000/
         clip.fdl             the storyboard drawn for the clip (run it with facelib)
-        clip.fap             the animation's FAP stream (standard .fap)
+        clip.fap             the animation's FAP stream (standard .fap, FAP 1/2 decoded)
+        clip.extended.fap    when the clip uses extended FAPs 69-84 (the nose) or FAP 1/2:
+                             every FAP (facelib's extended dialect)
         frames/frame_NNNNNN.png, or clip.mp4 (``media``)
         frames.jsonl         per frame: time, expressions, eye behaviour, viseme, head
                              pose, and 2-D pixel positions of every feature point
@@ -356,7 +358,7 @@ def make_clip(spec: DatasetSpec, index: int, out_dir: str | os.PathLike[str]) ->
     ``"skipped"``. Safe to run anywhere that sees ``out_dir`` (a Dask worker)."""
     from facelib.animation import animate
     from facelib.fdl import loads
-    from facelib.mpeg4 import write_fap
+    from facelib.mpeg4 import write_fap_complete
 
     final = Path(out_dir) / CLIP_PATTERN.format(index)
     if final.is_dir():
@@ -369,7 +371,7 @@ def make_clip(spec: DatasetSpec, index: int, out_dir: str | os.PathLike[str]) ->
         stream = _with_head(animation.faps, draw.head_deg)
         stream = stream[: max(1, round(spec.seconds * spec.fps))]
         (temp / "clip.fdl").write_text(text, encoding="utf-8")
-        write_fap(stream, temp / "clip.fap", name=final.name)
+        write_fap_complete(stream, temp / "clip.fap", name=final.name)
         labels = _frame_labels(animation, stream)
         _render_clip(spec, draw, stream, temp, labels)
         (temp / "frames.jsonl").write_text(

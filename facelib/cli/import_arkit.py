@@ -19,7 +19,7 @@ def add(commands: Any) -> None:
     imp.add_argument("capture", help="the Live Link Face .csv (or facelib's ARKit .json)")
     imp.add_argument("-o", "--output", required=True, help="OUT.fap, or - for stdout")
     imp.add_argument("--fps", type=float,
-                     help="timecode rate of the capture (default: read from the timecodes)")
+                     help="frame base of the timecodes (default: read; the app counts at 60)")
     imp.add_argument("--resample", type=float, help="resample to this frame rate (e.g. 25)")
     imp.add_argument("--dialect", default="standard",
                      choices=("standard", "xface", "greta", "extended"))

@@ -12,7 +12,7 @@ from typing import Any
 from facelib.cli.console import EXIT_ERROR, EXIT_OK, Console, UsageError
 from facelib.cli.options import COMMON, face_path, read_source
 from facelib.cli.outputs import RENDER_SUFFIXES, check_suffix, default_output
-from facelib.mpeg4 import FapStream, write_fap
+from facelib.mpeg4 import FapStream, write_fap_complete
 
 
 def _add_render_options(command: argparse.ArgumentParser, *, batch: bool) -> None:
@@ -58,8 +58,9 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
     if args.fap is not None:
         check_suffix(args.fap, (".fap",), "--fap")
         stream = source if isinstance(source, FapStream) else source.faps
-        write_fap(stream, args.fap)
-        console.status(f"wrote {args.fap} ({stream.n_frames} frames, {stream.duration:.2f} s)")
+        written_faps = write_fap_complete(stream, args.fap)
+        console.status(f"wrote {' and '.join(map(str, written_faps))} ({stream.n_frames} "
+                       f"frames, {stream.duration:.2f} s)")
     written = render(source, face=face_path(args.face), out=out, width=args.width,
                      framing=args.framing,
                      height=args.height, audio=args.audio, fps=args.fps,

@@ -5,7 +5,14 @@ Loaded on first use (``facelib.export_gltf`` ...); the glTF container needs the 
 extra (pygltflib), the web player the npm build (``make web``).
 """
 
-from facelib.export.arkit import ANGLE_NAMES, ArkitCurves, arkit_names, from_arkit, to_arkit
+from facelib.export.arkit import (
+    ANGLE_NAMES,
+    ArkitCurves,
+    arkit_names,
+    from_arkit,
+    live_link_names,
+    to_arkit,
+)
 from facelib.export.gltf import GltfExport, export_gltf
 from facelib.export.livelink import (
     export_arkit,
@@ -19,7 +26,8 @@ from facelib.export.web import WebExport, export_html
 
 __all__ = [
     "ANGLE_NAMES", "ArkitCurves", "GltfExport", "WebExport", "arkit_names", "export_arkit",
-    "export_gltf", "export_html", "from_arkit", "import_arkit", "read_arkit_json",
+    "export_gltf", "export_html", "from_arkit", "import_arkit", "live_link_names",
+    "read_arkit_json",
     "read_live_link_csv", "to_arkit", "write_arkit_json", "write_live_link_csv",
 ]
 

@@ -27,7 +27,8 @@ from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, N_STANDARD_FAPS
 
-__all__ = ["ANGLE_NAMES", "ArkitCurves", "arkit_names", "from_arkit", "to_arkit"]
+__all__ = ["ANGLE_NAMES", "ArkitCurves", "arkit_names", "from_arkit", "live_link_names",
+           "live_link_order", "to_arkit"]
 
 ANGLE_NAMES = ("HeadYaw", "HeadPitch", "HeadRoll", "LeftEyeYaw", "LeftEyePitch", "LeftEyeRoll",
                "RightEyeYaw", "RightEyePitch", "RightEyeRoll")
@@ -68,9 +69,31 @@ def _table() -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
             tuple(r["solve"] for r in rows))
 
 
+@cache
+def _live_link_order() -> tuple[int, ...]:
+    rows = [(int(row["live_link_face"]), row["name"]) for _, row in
+            data.csv_rows("export/arkit.csv")]
+    by_column = sorted(rows)
+    if [c for c, _ in by_column] != list(range(len(rows))):
+        raise FaceModelError("export/arkit.csv: live_link_face is not a permutation of 0-51")
+    return tuple(arkit_names().index(name) for _, name in by_column)
+
+
 def arkit_names() -> tuple[str, ...]:
-    """The 52 ARKit names in Live Link Face order (``EyeBlinkLeft`` ... ``TongueOut``)."""
+    """The 52 ARKit names in facelib's order (Unreal's ``EARFaceBlendShape``: ``EyeBlinkLeft``
+    ... ``TongueOut``), the columns of :attr:`ArkitCurves.weights`."""
     return _table()[0]
+
+
+def live_link_names() -> tuple[str, ...]:
+    """The 52 names in the column order of the Live Link Face app's CSV (``JawRight`` before
+    ``JawLeft``, ``MouthRight`` before ``MouthLeft``)."""
+    return tuple(arkit_names()[k] for k in _live_link_order())
+
+
+def live_link_order() -> tuple[int, ...]:
+    """For each Live Link Face CSV column 0-51, its index in :func:`arkit_names`."""
+    return _live_link_order()
 
 
 def arkit_regions() -> tuple[str, ...]:

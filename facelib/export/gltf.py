@@ -38,8 +38,10 @@ class GltfExport:
     """What :func:`export_gltf` wrote.
 
     path: the ``.glb``; audio: the speech audio copied beside it, or None.
-    targets: FAP number of each morph target, in target order; scales: (T,) float32 the FAP
-        value at which each target's weight is 1 (the stream's largest magnitude).
+    targets: FAP number of each morph target, in target order (a FAP whose values take both
+        signs has two targets, one per sign); scales: (T,) float32 the FAP value at which
+        each target's weight is 1 (the stream's largest value of that sign: negative for the
+        negative target). Every animated weight is in [0, 1] (Blender clamps to that).
     n_frames, fps: the animation's frames (one keyframe per frame) and rate.
     """
 
@@ -104,6 +106,39 @@ class _Builder:
 
     def blob(self) -> bytes:
         return b"".join(self.chunks)
+
+
+def signed_targets(
+    rows: np.ndarray, values: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Morph targets whose weights are never negative (Blender's importer clamps weights to
+    [0, 1]; three.js and Unity play them as they are).
+
+    rows: (R,) operator rows, values: (n, R) float32 their FAP values (:func:`morph_weights`).
+    Returns ``(rows (T,) int64, scales (T,) float32, weights (n, T) float32)``: a row with
+    positive values gets a target at ``scale`` = its largest value, one with negative values a
+    target at ``scale`` = its most negative value (a row with both gets both, positive
+    first); ``weights = max(value / scale, 0)`` in [0, 1], and
+    ``sum_t weights[:, t] * scales[t]`` over a row's targets gives back its values.
+    """
+    out_rows, out_scales, out_weights = [], [], []
+    for k, row in enumerate(rows):
+        column = values[:, k].astype(np.float32)
+        for scale in (float(column.max(initial=0.0)), float(column.min(initial=0.0))):
+            if scale != 0.0:
+                out_rows.append(int(row))
+                out_scales.append(scale)
+                out_weights.append(np.clip(column / np.float32(scale), 0.0, 1.0))
+    n = len(values)
+    return (np.array(out_rows, np.int64), np.array(out_scales, np.float32),
+            np.stack(out_weights, 1).astype(np.float32) if out_weights else
+            np.zeros((n, 0), np.float32))
+
+
+def _target_name(row: int, scale: float) -> str:
+    """``fap4_lower_t_midlip`` for a positive target, ``fap4_lower_t_midlip_neg`` for the
+    negative one."""
+    return f"fap{row + 1}_{fap(row + 1).name}" + ("_neg" if scale < 0 else "")
 
 
 def _import_pygltflib() -> Any:
@@ -263,9 +298,7 @@ def export_gltf(
     face = default_face() if face is None else face
     rig = build_rig(face)
     pose = pose_rig(face, rig, stream)
-    rows, values = morph_weights(face, stream)
-    scales = np.maximum(np.abs(values).max(axis=0), 1e-6).astype(np.float32) if len(
-        values) else np.ones(len(rows), np.float32)
+    rows, scales, weights = signed_targets(*morph_weights(face, stream))
     dense = face.operator[rows].toarray().reshape(len(rows), face.n_vertices, 3)
     targets = (dense * scales[:, None, None]).astype(np.float32)
     copied = _copy_audio(audio_path, out)
@@ -275,19 +308,21 @@ def export_gltf(
         "audio": copied.name if copied else None, "audio_offset": float(offset),
         "targets": [{"fap": int(r) + 1, "name": fap(int(r) + 1).name, "scale": float(s)}
                     for r, s in zip(rows, scales, strict=True)],
+        "_targets": "each target is a FAP's displacement at FAP value scale; a FAP with values "
+                    "of both signs has one target per sign, so every weight is in [0, 1]",
         "joint_fractions": FRACTIONS}}
     b = _Builder(g, lib)
     mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, targets),
                     weights=[0.0] * len(rows) if len(rows) else None)
     if len(rows):
-        mesh.extras = {"targetNames": [f"fap{int(r) + 1}_{fap(int(r) + 1).name}" for r in rows]}
+        mesh.extras = {"targetNames": [_target_name(int(r), float(s))
+                                       for r, s in zip(rows, scales, strict=True)]}
     g.meshes.append(mesh)
     g.nodes.append(lib.Node(name="face", mesh=0, skin=0))
     joint_nodes = _skeleton(b, rig, pose)
     g.scenes.append(lib.Scene(name="facelib", nodes=[0, joint_nodes[0]]))
     g.scene = 0
-    _animation(b, joint_nodes, values / scales if len(rows) else values[:, :0], pose,
-               fps=float(stream.fps))
+    _animation(b, joint_nodes, weights, pose, fps=float(stream.fps))
     blob = b.blob()
     g.buffers.append(lib.Buffer(byteLength=len(blob)))
     g.set_binary_blob(blob)

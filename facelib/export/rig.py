@@ -29,7 +29,9 @@ from facelib.mpeg4.stream import FapStream
 __all__ = ["FRACTIONS", "Pose", "Rig", "build_rig", "morph_weights", "pose_rig"]
 
 FRACTIONS = 8
-_LID_NAMES = ("lid_upper_l", "lid_upper_r", "lid_lower_l", "lid_lower_r")
+# each eyelid hinge's joint chain is named for the FAP that drives it (FAP 19-22: close the
+# top left, top right, bottom left, bottom right eyelid; the face's left is +x)
+_LID_NAMES = {19: "lid_upper_l", 20: "lid_upper_r", 21: "lid_lower_l", 22: "lid_lower_r"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,10 +79,11 @@ def build_rig(face: Face) -> Rig:
     rest = [face.pivots["head"]] * (FRACTIONS + 1) + [face.pivots["eye_l"], face.pivots["eye_r"],
                                                       face.pivots["jaw"]]
     lid_first = []
-    for k, (_, _, pivot, _) in enumerate(r.lids.hinges):
+    for k, (fap_index, _, pivot, _) in enumerate(r.lids.hinges):
         lid_first.append(len(names))
+        chain_name = _LID_NAMES.get(int(fap_index) + 1, f"lid_{k}")
         for j in range(1, FRACTIONS + 1):
-            names.append(f"{_LID_NAMES[k] if k < 4 else f'lid_{k}'}_{j}")
+            names.append(f"{chain_name}_{j}")
             parents.append(head)
             rest.append(pivot)
     nv = face.n_vertices

@@ -8,6 +8,7 @@ from facelib.mpeg4.fapfile import (
     read_fap,
     read_fap_file,
     write_fap,
+    write_fap_complete,
 )
 from facelib.mpeg4.stream import EXPRESSION_FIELDS, VISEME_FIELDS, FapStream
 from facelib.mpeg4.tables import (
@@ -49,4 +50,5 @@ __all__ = [
     "read_fap",
     "read_fap_file",
     "write_fap",
+    "write_fap_complete",
 ]

@@ -14,7 +14,9 @@ Dialects the reader accepts (detected per file, reported as ``FapFile.dialect``)
     69 mask tokens (Greta's frame has one unused slot after FAP 68), integer values, a
     header name that may contain spaces, FAP 1/2 as single tokens.
 ``vreng``
-    Version ``2.0`` style: frame numbers start at 1 and tokens are tab-separated.
+    Frame numbers start at 1 (VREng's own 2.0 samples: tab-separated with frames from 0, or
+    space-separated with frames from 1). Written with single spaces, as VREng's reader splits
+    on ``' '`` only.
 ``extended``
     84 mask tokens: facelib's extended FAPs 69-84 (annex A, table A.3) follow FAP 68.
 
@@ -43,6 +45,7 @@ import numpy as np
 from facelib.atomic import write_text_atomic
 from facelib.checks import check_kind
 from facelib.errors import FacelibWarning, FapFormatError, ParameterError
+from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import (
     EXPRESSION_FIELDS,
     EXPRESSION_LIMITS,
@@ -406,9 +409,11 @@ def write_fap(
         and C++) and VREng), ``"xface"`` (68 mask tokens, values with decimals, plus the
         FAP 1/2 token groups: only Xface reads it right, and it warns), ``"greta"`` (69 mask
         tokens, the 69th always 0, as Greta writes), ``"vreng"`` (standard with frames
-        numbered from 1, tab-separated) or ``"extended"`` (84 mask tokens with facelib's
-        FAPs 69-84, plus FAP 1/2; only facelib reads it). Every dialect but ``extended``
-        warns, naming them, when it drops extended FAPs 69-84 that carry values; ``greta``
+        numbered from 1, space-separated, as VREng's reader splits) or ``"extended"`` (84
+        mask tokens with facelib's FAPs 69-84, plus FAP 1/2; only facelib reads it). Every
+        dialect but ``extended`` warns, naming them, when it drops extended FAPs 69-84 that
+        carry values, and ``standard``, ``greta`` and ``vreng`` when they drop FAP 1/2
+        (viseme, expression: decode them first, or see :func:`write_fap_complete`); ``greta``
         warns unless the stream has 25 fps (Greta plays every file at 25), ``xface`` and
         ``extended`` when over 8000 frames carry FAP 1/2 (Greta's C++ reader crashes).
     name:
@@ -439,7 +444,7 @@ def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "fac
     high_level = dialect in ("xface", "extended")
     values = [_decimal(v) for v in stream.values.ravel()] if dialect == "xface" else [
         str(v) for v in np.rint(stream.values).astype(np.int64).ravel()]
-    first, sep = (1, "\t") if dialect == "vreng" else (0, " ")
+    first, sep = (1 if dialect == "vreng" else 0), " "  # VREng splits on ' ' only
     mask = np.zeros((stream.n_frames, width), bool)
     # Greta's 69th slot is unused: FAP 69 (an extended FAP) must never land there
     kept = min(width, N_FAPS if dialect == "extended" else N_STANDARD_FAPS)
@@ -464,6 +469,37 @@ def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "fac
     return "\n".join(out) + "\n"
 
 
+def write_fap_complete(
+    stream: FapStream, path: str | os.PathLike[str], *, name: str | None = None
+) -> tuple[Path, ...]:
+    """Write ``stream`` so that every FAP its frames show is kept, without a warning.
+
+    ``path`` gets the ``standard`` dialect, which every player reads, with FAP 1/2 decoded
+    into the FAPs 3-68 the frames do not set (:func:`~facelib.mpeg4.highlevel.apply_high_level`,
+    so players without FAP 1/2 show the same mouth). When the stream also carries extended
+    FAPs 69-84 or FAP 1/2, a second file ``<stem>.extended.fap`` beside it holds all of them
+    in the ``extended`` dialect (only facelib reads it).
+
+    Returns the paths written: ``(path,)`` or ``(path, <stem>.extended.fap)``.
+    """
+    path = Path(path)
+    name = name if name is not None else path.stem
+    decoded = apply_high_level(stream)
+    mask = np.array(decoded.mask)
+    high = (stream.viseme is not None and bool(stream.mask[:, 0].any())) or (
+        stream.expression is not None and bool(stream.mask[:, 1].any()))
+    extended = bool((mask[:, N_STANDARD_FAPS:] & (decoded.values[:, N_STANDARD_FAPS:] != 0))
+                    .any())
+    mask[:, :2] = False
+    mask[:, N_STANDARD_FAPS:] = False
+    write_fap(FapStream(decoded.fps, decoded.values, mask), path, name=name)
+    if not (high or extended):
+        return (path,)
+    beside = path.with_name(f"{path.stem}.extended{path.suffix}")
+    write_fap(stream, beside, dialect="extended", name=name)
+    return path, beside
+
+
 def _decimal(value: float) -> str:
     """``value`` with up to 3 decimals and at least one (``100.0``, ``-12.5``)."""
     text = f"{value:.3f}".rstrip("0")
@@ -483,6 +519,16 @@ def _warn_dropped(stream: FapStream, label: str, dialect: str) -> None:
                 f"{label}: the {dialect} dialect has no extended FAPs; dropping FAP "
                 f"{', '.join(map(str, dropped))} (write dialect='extended' to keep them; "
                 "only facelib reads that dialect)", FacelibWarning, stacklevel=4)
+    if dialect not in ("xface", "extended"):
+        for slot, what, field in ((0, "viseme", stream.viseme), (1, "expression",
+                                                                  stream.expression)):
+            frames = int(stream.mask[:, slot].sum()) if field is not None else 0
+            if frames:
+                warnings.warn(
+                    f"{label}: the {dialect} dialect has no FAP {slot + 1} ({what}); dropping it "
+                    f"in {frames} frames (decode it into FAPs 3-68 first with "
+                    "facelib.mpeg4.apply_high_level, or write_fap_complete, which does)",
+                    FacelibWarning, stacklevel=4)
     if dialect == "greta" and stream.fps != _GRETA_FPS:
         warnings.warn(
             f"{label}: Greta's Java reader ignores the header's frame rate and plays "

@@ -67,7 +67,22 @@ class Gltf:
 
     def evaluate(self, frame: int) -> list[np.ndarray]:
         """World positions (Vp, 3) of each primitive of mesh 0 at keyframe ``frame``."""
-        local = self.local_matrices(frame)
+        return self.pose(self.local_matrices(frame))
+
+    def rest_matrices(self) -> list[np.ndarray]:
+        """Every node's local matrix as the nodes give it (no animation); weights all 0."""
+        mats = []
+        for n in self.g.nodes:
+            m = np.eye(4)
+            m[:3, :3] = Rotation.from_quat(n.rotation or [0, 0, 0, 1]).as_matrix()
+            m[:3, 3] = n.translation or [0, 0, 0]
+            mats.append(m)
+        self._weights = np.zeros(len(self.g.meshes[0].weights or []))
+        return mats
+
+    def pose(self, local: list[np.ndarray]) -> list[np.ndarray]:
+        """World positions (Vp, 3) of each primitive of mesh 0 with the nodes' local matrices
+        ``local`` and the morph weights of the last ``local_matrices``/``rest_matrices``."""
         parent = {c: i for i, n in enumerate(self.g.nodes) for c in (n.children or [])}
 
         def world(i: int) -> np.ndarray:

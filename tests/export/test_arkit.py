@@ -18,6 +18,7 @@ from facelib.export import (
     export_arkit,
     from_arkit,
     import_arkit,
+    live_link_names,
     read_arkit_json,
     read_live_link_csv,
     to_arkit,
@@ -45,17 +46,19 @@ def test_csv_has_live_link_faces_layout(hello_csv, hello):
     path, _ = hello_csv
     rows = list(csv.reader(path.read_text().splitlines()))
     assert rows[0][:2] == ["Timecode", "BlendShapeCount"]
-    assert rows[0][2:54] == list(arkit_names()) and len(arkit_names()) == 52
+    assert rows[0][2:54] == list(live_link_names()) and len(arkit_names()) == 52
+    assert rows[0][17:19] == ["JawRight", "JawLeft"]  # the app's order, not the table's
     assert rows[0][54:] == ["HeadYaw", "HeadPitch", "HeadRoll", "LeftEyeYaw", "LeftEyePitch",
                             "LeftEyeRoll", "RightEyeYaw", "RightEyePitch", "RightEyeRoll"]
     assert rows[0][2] == "EyeBlinkLeft" and rows[0][19] == "JawOpen" and rows[0][53] == "TongueOut"
     assert len(rows) == hello.faps.n_frames + 1
     assert all(len(r) == 63 and r[1] == "61" for r in rows[1:])
     assert all(re.fullmatch(r"\d\d:\d\d:\d\d:\d\d\.\d\d\d", r[0]) for r in rows[1:])
-    assert rows[26][0] == "00:00:01:00.000" and rows[27][0] == "00:00:01:01.000"  # 25 fps
+    # 25 fps rows, the frame field counted at 60 as the app does
+    assert rows[26][0] == "00:00:01:00.000" and rows[27][0] == "00:00:01:02.400"
     weights = np.array([[float(v) for v in r[2:54]] for r in rows[1:]])
     assert weights.min() >= 0 and weights.max() <= 1
-    assert weights[:, arkit_names().index("JawOpen")].max() > 0.1  # speech opens the jaw
+    assert weights[:, live_link_names().index("JawOpen")].max() > 0.1  # speech opens the jaw
 
 
 def test_fit_reports_its_residual(hello_csv):
@@ -140,8 +143,8 @@ def test_bad_files_and_faces(tmp_path):
     bad.write_text("Timecode,BlendShapeCount,Foo\n")
     with pytest.raises(ArkitFormatError, match="Live Link Face"):
         read_live_link_csv(bad)
-    rows = ["Timecode,BlendShapeCount," + ",".join(arkit_names()),
-            "00:00:00:00.000,61," + ",".join(["0"] * 52), "00:00:00:01.000,61,x" + ",0" * 51]
+    rows = ["Timecode,BlendShapeCount," + ",".join((*arkit_names(), *ANGLE_NAMES)),
+            "00:00:00:00.000,61," + ",".join(["0"] * 61), "00:00:00:01.000,61,x" + ",0" * 60]
     bad.write_text("\n".join(rows) + "\n")
     with pytest.raises(ArkitFormatError, match=r"bad\.csv:3"):
         read_live_link_csv(bad)

@@ -9,10 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from gltf_eval import Gltf, busy_stream
+from scipy.spatial.transform import Rotation
 
 from facelib.data import json_data
 from facelib.engine import default_face
 from facelib.export import export_gltf
+from facelib.mpeg4 import fap
 
 WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
 
@@ -116,3 +118,66 @@ def test_exports_are_lazy_names_of_facelib():
 
     assert facelib.export_gltf is ex.export_gltf and facelib.import_arkit is ex.import_arkit
     assert {"export_gltf", "export_html", "export_arkit", "import_arkit"} <= set(facelib.__all__)
+
+
+def test_no_negative_morph_weights_a_signed_fap_is_two_targets(tmp_path):
+    """Blender's importer clamps morph weights to [0, 1] (issue 36): every weight the file
+    animates is in [0, 1]; a FAP with values of both signs is two targets, one per sign, and
+    their weighted sum is the FAP's displacement."""
+    from facelib import FapStream
+
+    n = 9
+    values = np.zeros((n, 84), np.float32)
+    values[:, fap("raise_b_midlip").index] = np.linspace(-300, 200, n)  # both signs
+    values[:, fap("open_jaw").index] = np.linspace(0, 400, n)  # positive only
+    values[:, fap("stretch_l_cornerlip").index] = np.linspace(0, -150, n)  # negative only
+    stream = FapStream(25, values, np.ones((n, 84), bool))
+    result = export_gltf(stream, tmp_path / "signs.glb")
+    gltf = Gltf(result.path)
+    gltf.local_matrices(0)
+    animated = np.stack([(gltf.local_matrices(i), gltf._weights)[1] for i in range(n)])
+    assert animated.min() >= 0 and animated.max() <= 1 + 1e-6
+    lip, jaw, corner = (fap(k).id for k in ("raise_b_midlip", "open_jaw",
+                                                "stretch_l_cornerlip"))
+    assert result.targets.count(lip) == 2 and result.targets.count(jaw) == 1
+    assert result.targets.count(corner) == 1
+    scales = dict(zip(result.targets, result.scales, strict=True))
+    assert scales[corner] < 0 and scales[jaw] > 0
+    face = default_face()
+    want = face.deform(stream)
+    for frame in (0, 4, 8):
+        got = gltf.evaluate(frame)
+        for part, positions in zip(face.parts.values(), got, strict=True):
+            ids = np.sort(part.vertex_ids)
+            np.testing.assert_allclose(positions, want[frame][ids], atol=1e-4)
+
+
+def test_each_eyelid_joint_chain_moves_the_lid_it_is_named_for(exported):
+    """Turn the joints of each ``lid_<upper|lower>_<l|r>_*`` chain alone and look at the
+    vertices that follow: the face's left is +x (feature point 3.5, the left pupil, has x > 0
+    in the face definition); the upper lid lies above the eye centre, the lower below."""
+    result, _ = exported
+    face = default_face()
+    assert face.vertices[face.feature_points["3.5"], 0] > 0  # left pupil: +x
+    gltf = Gltf(result.path)
+    names = [n.name for n in gltf.g.nodes]
+    rest = gltf.rest_matrices()
+    still = gltf.pose(rest)
+    skin_ids = np.sort(face.parts["skin"].vertex_ids)
+    skin_index = list(face.parts).index("skin")
+    for side, sign in (("l", 1), ("r", -1)):
+        centre = face.pivots[f"eye_{side}"]
+        for lid in ("upper", "lower"):
+            local = [m.copy() for m in rest]
+            for j in range(1, 9):
+                joint = names.index(f"lid_{lid}_{side}_{j}")
+                local[joint][:3, :3] = local[joint][:3, :3] @ Rotation.from_rotvec(
+                    [0.3, 0, 0]).as_matrix()
+            moved = np.linalg.norm(gltf.pose(local)[skin_index] - still[skin_index], axis=1)
+            follow = face.vertices[skin_ids[moved > 1e-5]]
+            assert len(follow) > 10, (lid, side)
+            assert np.all(np.sign(follow[:, 0]) == sign), f"lid_{lid}_{side}: wrong side"
+            above = float((follow[:, 1] > centre[1]).mean())
+            print(f"lid_{lid}_{side}: {len(follow)} vertices, {above:.2f} above the eye centre")
+            assert above > 0.75 if lid == "upper" else above < 0.25, \
+                f"lid_{lid}_{side}: {above:.2f} of its vertices above the eye centre"
