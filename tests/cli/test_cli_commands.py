@@ -52,6 +52,7 @@ def test_plot_writes_a_png(tmp_path):
     assert out.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.render  # renders video
 def test_render_and_play(tmp_path):
     if importlib.util.find_spec("pyrender") is None:  # importing it would pick a GL platform
         pytest.skip("rendering needs the render extra")

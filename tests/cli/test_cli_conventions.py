@@ -80,6 +80,7 @@ def test_quiet_prints_nothing_and_verbose_explains(tmp_path, capsys):
     assert "Traceback" not in capsys.readouterr().err
 
 
+@pytest.mark.slow  # four fresh processes
 def test_a_closed_pipe_ends_quietly(tmp_path):
     """`facelib ... | head` where head has already gone: the write fails with EPIPE."""
     story = long_storyboard(tmp_path, 30)  # ~200 kB of .fap text
