@@ -95,6 +95,7 @@ def test_interrupted_write_leaves_no_temporary(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow  # starts and kills processes
 def test_temporaries_of_killed_processes_are_swept(tmp_path):
     """A process killed with SIGKILL cannot clean up; the next write to the folder does."""
     code = ("import os, sys\nfrom facelib.atomic import atomic_path\n"
