@@ -30,6 +30,7 @@ from facelib.errors import (
     RenderError,
     SpeechError,
     SpeechWarning,
+    facelib_warnings,
 )
 from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
 
@@ -94,6 +95,7 @@ __all__ = [
     "export_gltf",
     "export_html",
     "expressions",
+    "facelib_warnings",
     "fap",
     "fdl",
     "feature_point",

@@ -1,20 +1,25 @@
 """Atomic file output: readers never see a half-written file, and a failure leaves any
 previous file as it was.
 
-The temporary file is written beside the target as ``.<stem>.<pid>.<random><suffix>``; a
-temporary file left by a process that no longer runs (killed with SIGKILL, say) is removed
-by the next write to the same folder. Only regular files are ever replaced: a device, pipe,
-folder or symbolic link at the target is refused, so ``-o /dev/null`` can never turn a
+The temporary file is written beside the target as
+``.facelib-tmp-<pid>-<token>-<check><suffix>``: a fixed prefix, the writing process's id, 12
+random hex digits and 8 hex digits of a keyed hash of the pid and token. A temporary left by
+a process that no longer runs (killed with SIGKILL, say) is removed by the next write to the
+same folder; the sweep removes only regular files of this user whose whole name has this
+shape and whose check matches, so no file a user made (``.photo.2019.holidays.jpg``) is ever
+touched, whatever numbers its name holds. Only regular files are ever replaced: a device,
+pipe, folder or symbolic link at the target is refused, so ``-o /dev/null`` can never turn a
 device into a file.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import re
+import secrets
 import stat
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -23,13 +28,38 @@ from facelib.errors import FileError
 __all__ = [
     "atomic_path",
     "check_output_path",
+    "is_temporary",
     "output_folder",
     "publish",
     "temp_beside",
     "write_text_atomic",
 ]
 
-_TEMP = re.compile(r"^\..+\.(?P<pid>[0-9]+)\.[A-Za-z0-9_]{8}(\.[^.]*)?$")
+_PREFIX = ".facelib-tmp-"
+_TEMP = re.compile(r"\.facelib-tmp-(?P<pid>[1-9][0-9]{0,9})-(?P<token>[0-9a-f]{12})"
+                   r"-(?P<check>[0-9a-f]{8})(?:\.[A-Za-z0-9]{1,16})?")
+_MAX_PID = 2**31 - 1  # pid_t; a larger number in a name is never a process of ours
+_KEY = b"facelib atomic temporary v1"
+
+
+def _check(pid: int, token: str) -> str:
+    """The 8 hex digits that mark a temporary name as facelib's own."""
+    return hashlib.blake2s(f"{pid}-{token}".encode(), key=_KEY, digest_size=4).hexdigest()
+
+
+def _temp_name(suffix: str) -> str:
+    pid = os.getpid()
+    token = secrets.token_hex(6)
+    return f"{_PREFIX}{pid}-{token}-{_check(pid, token)}{suffix}"
+
+
+def is_temporary(name: str) -> bool:
+    """Whether ``name`` (a file name, no folder) is one facelib's writers made: the prefix,
+    a pid that fits ``pid_t``, the token and its matching check, an optional short suffix."""
+    match = _TEMP.fullmatch(name)
+    if match is None or int(match["pid"]) > _MAX_PID:
+        return False
+    return secrets.compare_digest(match["check"], _check(int(match["pid"]), match["token"]))
 
 
 def check_output_path(path: str | os.PathLike[str]) -> Path:
@@ -71,11 +101,16 @@ def output_folder(path: str | os.PathLike[str]) -> Path:
 
 def _sweep(folder: Path) -> None:
     """Remove temporary files of earlier writes whose process has ended."""
+    uid = os.getuid() if hasattr(os, "getuid") else None
     with contextlib.suppress(OSError):
         for entry in os.scandir(folder):
-            match = _TEMP.match(entry.name)
-            if match and entry.is_file(follow_symlinks=False) and not _alive(int(match["pid"])):
-                with contextlib.suppress(OSError):
+            if not entry.name.startswith(_PREFIX) or not is_temporary(entry.name):
+                continue
+            with contextlib.suppress(OSError):
+                info = entry.stat(follow_symlinks=False)
+                if not stat.S_ISREG(info.st_mode) or (uid is not None and info.st_uid != uid):
+                    continue
+                if not _alive(int(entry.name[len(_PREFIX):].split("-", 1)[0])):
                     Path(entry.path).unlink()
 
 
@@ -86,7 +121,7 @@ def _alive(pid: int) -> bool:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:
+    except (PermissionError, OverflowError, ValueError):
         return True
     return True
 
@@ -99,15 +134,23 @@ def temp_beside(path: str | os.PathLike[str], *, suffix: str | None = None) -> P
     (:func:`check_output_path`) or the folder cannot be written.
     """
     path = check_output_path(path)
+    ending = path.suffix if suffix is None else suffix
+    if not re.fullmatch(r"(\.[A-Za-z0-9]{1,16})?", ending):
+        ending = ""  # the sweep must recognise every name made here
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         _sweep(path.parent)
-        handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.{os.getpid()}.",
-                                        suffix=path.suffix if suffix is None else suffix)
+        while True:
+            temp = path.parent / _temp_name(ending)
+            try:
+                handle = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            except FileExistsError:
+                continue
+            break
     except OSError as exc:
         raise FileError.wrap(exc, "write", Path(path)) from exc
     os.close(handle)
-    return Path(name)
+    return temp
 
 
 def publish(temp: Path, path: str | os.PathLike[str]) -> Path:

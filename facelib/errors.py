@@ -2,11 +2,16 @@
 
 Every error facelib raises on purpose is a :class:`FacelibError`. Subclasses say which
 kind of input was wrong; each message names the offending value and, where there is one,
-the file and line it came from.
+the file and line it came from. Every warning is a :class:`FacelibWarning`;
+:func:`facelib_warnings` collects them and nothing else, for a program that shows its users
+facelib's warnings only.
 """
 
 from __future__ import annotations
 
+import contextlib
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 __all__ = [
@@ -26,6 +31,7 @@ __all__ = [
     "SpeechWarning",
     "TrackingError",
     "TrackingWarning",
+    "facelib_warnings",
 ]
 
 
@@ -132,3 +138,28 @@ class PronunciationWarning(SpeechWarning):
 
 class TrackingWarning(FacelibWarning):
     """Tracking went on but lost the face in some frames, or saw several faces (names them)."""
+
+
+@contextlib.contextmanager
+def facelib_warnings() -> Iterator[list[warnings.WarningMessage]]:
+    """Collect facelib's warnings raised inside the block; drop every other warning.
+
+    Yields a list that, when the block ends (normally or by an exception), holds each
+    :class:`FacelibWarning` raised inside, every time it was raised (not once per place),
+    in order; the others (numpy's ``RuntimeWarning``, a third party's deprecation) are
+    neither shown nor kept. Filters that turn a warning into an error still apply. The
+    ``facelib`` command prints the collected ones as ``facelib: warning: MESSAGE``.
+
+    >>> with facelib_warnings() as caught:
+    ...     warnings.warn("frames missing", FacelibWarning)
+    ...     warnings.warn("overflow", RuntimeWarning)
+    >>> [str(w.message) for w in caught]
+    ['frames missing']
+    """
+    kept: list[warnings.WarningMessage] = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FacelibWarning)
+        try:
+            yield kept
+        finally:
+            kept.extend(w for w in caught if issubclass(w.category, FacelibWarning))

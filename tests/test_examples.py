@@ -60,6 +60,7 @@ def test_hello_storyboard_speaks_emotes_and_looks():
         ("play_xface_fap.py", ["out/xface_smile_standard.fap", "out/xface_smile.mp4"]),
     ],
 )
+@pytest.mark.render  # the examples render videos
 def test_python_examples_run(tmp_path, script, outputs):
     if importlib.util.find_spec("pyrender") is None:  # importing it would pick a GL platform
         pytest.skip("rendering needs the render extra")

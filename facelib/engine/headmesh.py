@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from facelib.engine.mesh_files import ConfinedFiles, check_mesh_file
 from facelib.errors import FaceModelError, MissingExtraError
 
 __all__ = ["AXES", "MESH_SUFFIXES", "HeadMesh", "axes_rotation", "head_mesh", "load_head_mesh"]
@@ -250,21 +251,29 @@ def load_head_mesh(path: str | Path, *, parts: Mapping[str, str] | None = None) 
         by name). Objects named like eyes, teeth or tongue become those parts; two teeth
         objects split into upper and lower by height; everything else is skin.
 
-    Raises FaceModelError for unreadable files, unknown formats, empty meshes, or an
-    object name given in ``parts`` that the file does not have.
+    Raises FaceModelError for unreadable files, unknown formats, empty meshes, an
+    object name given in ``parts`` that the file does not have, or a file the mesh refers
+    to (texture, material library, buffer) outside its folder (see
+    :mod:`facelib.engine.mesh_files`).
     """
     path = Path(path)
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise FaceModelError(f"unknown mesh format {path.suffix!r}; use one of "
                              f"{', '.join(MESH_SUFFIXES)}", path=path)
+    check_mesh_file(path)
     trimesh = _trimesh()
+    files = ConfinedFiles(path)
     try:
         # OBJ: every object (o) and group (g) its own mesh, so separate eyeballs stay parts
         split = ({"split_objects": True, "split_groups": True}
                  if path.suffix.lower() == ".obj" else {})
-        scene = trimesh.load(path, force="scene", process=True, **split)
+        scene = trimesh.load(path, force="scene", process=True, resolver=files, **split)
+    except FaceModelError:
+        raise
     except Exception as exc:
+        files.check()
         raise FaceModelError(f"cannot read the mesh: {_reason(exc, path)}", path=path) from exc
+    files.check()
     dumped = _scene_meshes(scene)
     if path.suffix.lower() == ".obj":
         dumped = _obj_piece_names(dumped, path)

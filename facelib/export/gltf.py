@@ -10,7 +10,6 @@ frame (see :mod:`facelib.export.rig` for the construction and its error bound).
 from __future__ import annotations
 
 import os
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +21,7 @@ from facelib.atomic import atomic_path
 from facelib.engine import Face, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import MissingExtraError, ParameterError
+from facelib.export.audio import copy_audio
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, export_clip, face_of
 from facelib.mpeg4.tables import fap
@@ -262,16 +262,6 @@ def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: P
     b.g.animations.append(animation)
 
 
-def _copy_audio(audio: Path | None, out: Path) -> Path | None:
-    """Copy the speech audio beside ``out`` (same stem), atomically; the copy's path."""
-    if audio is None:
-        return None
-    copied = out.with_suffix(audio.suffix.lower())
-    with atomic_path(copied) as temp:
-        shutil.copyfile(audio, temp)
-    return copied
-
-
 def export_gltf(
     source: Source,
     out: str | os.PathLike[str],
@@ -288,8 +278,10 @@ def export_gltf(
     out: the ``.glb`` path (written atomically).
     face: the head (default: the bundled head).
     audio: speech audio to copy beside the file (default: the source's own audio file; see
-        the audio rule of :mod:`facelib.clip`). glTF has no audio: the copy is named in
-        ``asset.extras.facelib.audio``, its start in ``audio_offset`` (seconds).
+        the audio rule of :mod:`facelib.clip`), named ``out``'s stem with the suffix of the
+        format its content shows (``a.glb`` -> ``a.wav``); ParameterError if it shows none.
+        glTF has no audio: the copy is named in ``asset.extras.facelib.audio``, its start in
+        ``audio_offset`` (seconds).
     """
     lib = _import_pygltflib()
     out = Path(out)
@@ -303,7 +295,7 @@ def export_gltf(
     rows, scales, weights = signed_targets(*morph_weights(face, stream))
     dense = face.operator[rows].toarray().reshape(len(rows), face.n_vertices, 3)
     targets = (dense * scales[:, None, None]).astype(np.float32)
-    copied = _copy_audio(audio_path, out)
+    copied = copy_audio(audio_path, out)
     g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
     g.asset.extras = {"facelib": {
         "fps": float(stream.fps), "n_frames": int(stream.n_frames),

@@ -235,8 +235,16 @@ def _inputs_of(speech: SpeechSpec | None) -> tuple[Path, ...]:
 
 def _check_output(output: Path, *, inputs: tuple[Path | None, ...], ctx: Context) -> None:
     """A storyboard may only name an output facelib writes: a known suffix, not a hidden
-    file, not the storyboard itself or a file it reads."""
+    file, not the storyboard itself or a file it reads, in a folder that exists (a
+    storyboard never makes folders)."""
     line = _line(ctx.source, "output")
+    if not output.parent.is_dir():
+        base = ctx.base_dir.resolve() if ctx.base_dir is not None else output.parent
+        shown = (output.parent.relative_to(base).as_posix()
+                 if output.parent.is_relative_to(base) else str(output.parent))
+        raise FdlError(f"output {output.name!r}: the folder {shown!r} does not exist in the "
+                       "storyboard's folder (a storyboard never makes folders)",
+                       path=ctx.path, line=line)
     if output.suffix.lower() not in OUTPUT_SUFFIXES:
         raise FdlError(f"output {output.name!r} must end in one of {', '.join(OUTPUT_SUFFIXES)}",
                        path=ctx.path, line=line)

@@ -399,7 +399,8 @@ def write_fap(
     Parameters
     ----------
     stream:
-        The FAP stream; its fps must be a whole number (resample it otherwise).
+        The FAP stream; its fps must be a whole number (resample it otherwise:
+        ``stream.at_whole_rate()`` takes the nearest).
     path:
         The file to write.
     dialect:
@@ -434,7 +435,8 @@ def format_fap(stream: FapStream, *, dialect: str = "standard", name: str = "fac
         raise ParameterError(f"unknown .fap dialect {dialect!r}; choose one of {DIALECTS}")
     if not float(stream.fps).is_integer():
         raise ParameterError(f"a .fap file needs a whole frame rate, the stream has "
-                             f"{stream.fps:g} fps: resample it first (stream.resample(25))")
+                             f"{stream.fps:g} fps: resample it first (stream.resample(25), or "
+                             "stream.at_whole_rate() for the nearest)")
     _check_range(stream)
     label = "_".join(name.split()) or "facelib"
     _warn_dropped(stream, label, dialect)

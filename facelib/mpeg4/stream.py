@@ -195,6 +195,15 @@ class FapStream:
         values = np.where(both, (1 - w) * self.values[lo] + w * self.values[hi], self.values[lo])
         return self._take(lo, fps, values=values)
 
+    def at_whole_rate(self) -> FapStream:
+        """The stream at the nearest whole frame rate (at least 1 fps), as a ``.fap`` file
+        needs: the stream itself when its rate is whole, else resampled with :meth:`resample` (a
+        camera's measured 29.97 fps becomes 30, a landmark file's 12.5 becomes 12).
+        """
+        if float(self.fps).is_integer():
+            return self
+        return self.resample(max(1, round(self.fps)))
+
     @staticmethod
     def concat(streams: Iterable[FapStream]) -> FapStream:
         """Join streams end to end; they must share one frame rate."""

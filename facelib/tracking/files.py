@@ -31,7 +31,7 @@ import json
 import os
 import re
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NoReturn
@@ -67,6 +67,66 @@ class LandmarkFile:
 
 _WRITE_FRAMES = 256
 """Frames formatted at a time by :func:`write_landmarks_csv`."""
+
+MAX_FRAMES_PER_FRAME = 16
+"""A track spans at most this many frames for every frame the file holds ..."""
+MAX_LOST_VALUES = 2**24
+"""... plus lost frames worth this many coordinates (128 MiB of float64: 2 h of 68 2-D
+points at 17 fps, 8 min of 478 3-D points at 25 fps): a file's frame numbers and gaps never
+size memory beyond what it holds."""
+
+
+def _shown(value: float) -> str:
+    """A frame or point number as the file gave it (a whole number below 2^53 in full)."""
+    if np.isfinite(value) and value == round(value) and abs(value) <= 2.0**53:
+        return str(int(value))
+    return f"{value:g}"
+
+
+def _bound_track(numbers: np.ndarray, *, start: float | None, values_per_frame: int,
+                 locate: Callable[[int], tuple[Path, int | None]]) -> None:
+    """Refuse a track whose frame numbers ``(n,) float64`` (one per row of the file; whole
+    numbers) would size memory beyond what the file holds: a number at or past 2^53, or a
+    span (from ``start``, else the first frame, to the last) longer than
+    :data:`MAX_FRAMES_PER_FRAME` per frame held plus :data:`MAX_LOST_VALUES` coordinates
+    of ``values_per_frame`` each. ``locate(row)`` gives the file and line to name."""
+    big = np.flatnonzero(~(np.abs(numbers) < 2.0**53))
+    if big.size:
+        where, line = locate(int(big[0]))
+        raise TrackingError(f"frame {_shown(float(numbers[big[0]]))} is not a frame number "
+                            "(frames are whole numbers below 2^53)", path=where, line=line)
+    held = np.unique(numbers)
+    first = float(held[0]) if start is None else min(float(start), float(held[0]))
+    span = int(held[-1] - first) + 1
+    allowance = MAX_LOST_VALUES // max(values_per_frame, 1)
+    allowed = MAX_FRAMES_PER_FRAME * len(held) + allowance
+    if span <= allowed:
+        return
+    before = np.concatenate([[first - 1.0], held[:-1]])
+    j = int(np.argmax(held - before))
+    where, line = locate(int(np.flatnonzero(numbers == held[j])[0]))
+    after = f"frame {_shown(float(before[j]))}" if j else f"the track's start (frame {first:g})"
+    raise TrackingError(
+        f"frame {_shown(float(held[j]))} comes {_shown(float(held[j] - before[j]))} frames "
+        f"after {after}: the track would span {span} frames, more than the {allowed} allowed "
+        f"for the {len(held)} frames the file holds ({MAX_FRAMES_PER_FRAME} per frame held "
+        f"plus {allowance} lost)", path=where, line=line)
+
+
+def _row_line(path: Path, header_line: int, *, comments: bool) -> Callable[[int], tuple[
+        Path, int | None]]:
+    """``locate(row)`` for a CSV: the file and the line of its ``row``-th data row (0-based;
+    blank lines, rows of empty cells and, with ``comments``, ``#`` lines are no rows)."""
+    def locate(row: int) -> tuple[Path, int | None]:
+        count = 0
+        for line, cells in _data_rows(path, header_line, comments=comments):
+            if not any(c.strip() for c in cells):
+                continue
+            if count == row:
+                return path, line
+            count += 1
+        return path, None
+    return locate
 
 
 def guess_layout(n_points: int) -> str | None:
@@ -150,6 +210,14 @@ def _read_long_csv(path: Path, head: str) -> LandmarkFile:
     ids = table[:, :2]
     if (ids != np.round(ids)).any() or (ids < 0).any():
         _raise_bad_row(path, at, cols)
+    locate = _row_line(path, at, comments=True)
+    widest = int(np.argmax(ids[:, 1]))
+    if not ids[widest, 1] < len(table):  # a frame of K points needs K rows
+        where, line = locate(widest)
+        raise TrackingError(f"point {_shown(float(ids[widest, 1]))} is more points than the "
+                            f"file's {len(table)} rows hold", path=where, line=line)
+    _bound_track(ids[:, 0], start=0.0, values_per_frame=int(ids[:, 1].max() + 1) * dim,
+                 locate=locate)
     frame, point = ids.astype(np.int64).T
     if not (point == 0).any():  # numbered from 1, as iBUG's figure
         point = point - 1
@@ -227,9 +295,15 @@ def _read_openface(path: Path, head: str) -> LandmarkFile:
         raise TrackingError("no landmark rows after the header", path=path)
     if not _whole_numbers(table, named):
         _openface_rows(path, at, cols, named)  # raises, naming the row
+    rows = np.arange(len(table))
     if "face_id" in named:  # the first face id
-        table = table[table[:, named.index("face_id")] == table[:, named.index("face_id")].min()]
+        first_face = table[:, named.index("face_id")] == table[:, named.index("face_id")].min()
+        table, rows = table[first_face], rows[first_face]
     column = {n: table[:, k] for k, n in enumerate(named)}
+    if "frame" in column:
+        locate = _row_line(path, at, comments=False)
+        _bound_track(column["frame"], start=None, values_per_frame=2 * len(xs),
+                     locate=lambda row: locate(int(rows[row])))
     frame = column["frame"].astype(np.int64) if "frame" in column else np.arange(len(table))
     ok = column["success"] > 0 if "success" in column else np.ones(len(table), bool)
     points = np.stack([table[:, len(named):len(named) + len(xs)],
@@ -284,6 +358,9 @@ def _read_json(path: Path, text: str) -> LandmarkFile:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise TrackingError(f"invalid JSON: {exc.msg}", path=path, line=exc.lineno) from exc
+    except RecursionError:
+        raise TrackingError("the JSON is nested too deeply to be a landmark track (frames of "
+                            "points are 3 lists deep)", path=path) from None
     fps = None
     if isinstance(doc, dict):
         fps = None if doc.get("fps") is None else check_fps(doc["fps"])
@@ -337,9 +414,16 @@ def _read_pts_folder(path: Path) -> LandmarkFile:
     order = {int(n[-1]): f for n, f in zip(numbers, files, strict=True)}
     if len(order) != len(files):
         raise TrackingError("two .pts files have the same frame number", path=path)
-    first = min(order)
-    return _finish(path, [_read_pts_file(order[i]) if i in order else None
-                          for i in range(first, max(order) + 1)], None)
+    held = sorted(order)
+    points = {i: _read_pts_file(order[i]) for i in held}
+    for i in held:
+        if i >= 2**53:  # as a float it would read as another number
+            raise TrackingError(f"frame {i} is not a frame number (frames are whole numbers "
+                                "below 2^53)", path=order[i])
+    _bound_track(np.array(held, np.float64), start=None,
+                 values_per_frame=points[held[0]].size,
+                 locate=lambda row: (order[held[row]], None))
+    return _finish(path, [points.get(i) for i in range(held[0], held[-1] + 1)], None)
 
 
 _HEAD = 1 << 16

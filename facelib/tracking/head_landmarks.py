@@ -7,7 +7,8 @@ pixel is cast back onto the mesh; the first hit is the landmark. The mesh's own 
 then corrects what a face model trained on people misplaces on other faces: eyelid points
 snap onto their lid's rim and mouth corners into their fold (:func:`_settle`), and the
 nose tip, lower lip and chin points are placed on the midline profile
-(:mod:`facelib.tracking.profile`). The mesh must look along +z with +y up (any unit).
+(:mod:`facelib.tracking.profile`). The mesh is searched upright, looking along +z with +y
+up (any unit): give the axes of one that is not.
 
 Feature points whose MediaPipe position follows another convention than the default head's
 (mid and outer brows 4.3-4.6 on the brow's upper edge, nostrils 9.1/9.2, 9.15) and the
@@ -25,7 +26,7 @@ from typing import cast
 
 import numpy as np
 
-from facelib.engine.headmesh import HeadMesh
+from facelib.engine.headmesh import HeadMesh, axes_rotation
 from facelib.errors import FaceModelError, TrackingError
 
 __all__ = ["AUTO_EXCLUDED", "HeadLandmarks", "detect_head_landmarks", "draw_landmarks"]
@@ -150,19 +151,30 @@ def _through_holes(mesh: HeadMesh, origins: np.ndarray, directions: np.ndarray,
     return out
 
 
-def detect_head_landmarks(mesh: HeadMesh, *, size: int = 640,
+def detect_head_landmarks(mesh: HeadMesh, *, up: str | None = None,
+                          forward: str | None = None, size: int = 640,
                           feature_points: tuple[str, ...] | None = None) -> HeadLandmarks:
-    """Find feature points on an upright, front-facing head mesh (see the module docstring).
+    """Find feature points on a head mesh (see the module docstring).
 
+    up, forward: the mesh's axes ("+x" ... "-z", as for
+        :func:`~facelib.engine.headmesh.axes_rotation`) when it is not upright (+y up)
+        looking along +z; the mesh is turned upright for the search and the points are given
+        in the mesh's own frame, so they go with the same axes to ``set_up_face(mesh,
+        landmarks=found.as_json(), up=up, forward=forward)``. Default: upright.
     feature_points: the ids wanted (default: the default head's feature points); those in
         ``AUTO_EXCLUDED`` and the ones the MediaPipe table does not map are left out.
 
-    Raises FaceModelError when MediaPipe finds no face in the front view (the mesh is not
-    upright and facing +z, or not a face) or too few rays hit the mesh.
+    Raises ParameterError for an unknown axis, FaceModelError when MediaPipe finds no face
+    in the front view (the mesh is not upright and facing +z, or not a face) or too few
+    rays hit the mesh.
     """
     from facelib.tracking.layouts import landmark_layout
     from facelib.tracking.mediapipe import detect_landmarks
 
+    turn = None if up is None and forward is None else axes_rotation(up or "+y",
+                                                                      forward or "+z")
+    if turn is not None:
+        mesh = mesh.rotated(turn)
     image, pose, projection = _render(mesh, size)
     try:
         found = detect_landmarks(image)
@@ -191,6 +203,8 @@ def detect_head_landmarks(mesh: HeadMesh, *, size: int = 640,
         mesh, {fp: hit[k] for k, fp in enumerate(wanted) if ok[k]},
         {fp: pixels[rows[k]] for k, fp in enumerate(wanted) if ok[k]},
         camera=(pose, projection, size), front=front)
+    if turn is not None:  # back into the mesh's frame (a signed permutation: exact)
+        points = {fp: turn.T @ point for fp, point in points.items()}
     return HeadLandmarks(points=points, pixels=where, image=image)
 
 

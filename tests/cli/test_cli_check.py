@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import pytest
@@ -17,13 +16,6 @@ BAD = [
     ('define_gaze { "nervous", blink_rate = 0.6 }\nlook { "nervous", dur = 3 }',
      2, "eye behaviour 'nervous': unknown key"),
 ]
-
-
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        yield
 
 
 @pytest.mark.parametrize(("body", "line", "message"), BAD, ids=[b[2] for b in BAD])

@@ -1,7 +1,6 @@
 """The storyboard commands: check, run, render, plot, play, align."""
 
 import importlib.util
-import warnings
 from pathlib import Path
 
 import pytest
@@ -11,13 +10,6 @@ from facelib.cli import main
 
 ROOT = Path(__file__).parents[2]
 SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
-
-
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        yield
 
 
 def test_check_lists_cues_with_lines(capsys):
@@ -60,6 +52,7 @@ def test_plot_writes_a_png(tmp_path):
     assert out.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.render  # renders video
 def test_render_and_play(tmp_path):
     if importlib.util.find_spec("pyrender") is None:  # importing it would pick a GL platform
         pytest.skip("rendering needs the render extra")

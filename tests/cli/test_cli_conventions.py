@@ -7,8 +7,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
-import warnings
 from pathlib import Path
 
 import pytest
@@ -19,13 +17,6 @@ from facelib.cli import main
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = ROOT / "tests" / "data" / "pipeline" / "small.fdl"
 HAS_RENDER = importlib.util.find_spec("pyrender") is not None
-
-
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        yield
 
 
 def facelib_cmd(*args: str, **kwargs) -> subprocess.Popen:
@@ -62,7 +53,7 @@ def test_output_suffix_must_match_the_format(tmp_path, capsys):
     assert main(["plot", str(SMALL), "-o", str(tmp_path / "x.fap")]) == 2
 
 
-def test_storyboard_output_is_honoured_relative_to_the_current_directory(
+def test_storyboard_output_is_honoured_inside_the_storyboards_folder(
         tmp_path, monkeypatch, capsys):
     story = tmp_path / "stories" / "named.fdl"
     story.parent.mkdir()
@@ -71,8 +62,8 @@ def test_storyboard_output_is_honoured_relative_to_the_current_directory(
     here.mkdir()
     monkeypatch.chdir(here)
     assert main(["run", str(story)]) == 0
-    assert (here / "named_out.fap").is_file()
-    assert not (story.parent / "named_out.fap").exists()
+    assert (story.parent / "named_out.fap").is_file()
+    assert not (here / "named_out.fap").exists()
     assert "wrote" in capsys.readouterr().err  # status to stderr, stdout stays clean
 
 
@@ -89,6 +80,7 @@ def test_quiet_prints_nothing_and_verbose_explains(tmp_path, capsys):
     assert "Traceback" not in capsys.readouterr().err
 
 
+@pytest.mark.slow  # four fresh processes
 def test_a_closed_pipe_ends_quietly(tmp_path):
     """`facelib ... | head` where head has already gone: the write fails with EPIPE."""
     story = long_storyboard(tmp_path, 30)  # ~200 kB of .fap text
@@ -112,15 +104,6 @@ def test_a_closed_pipe_ends_quietly(tmp_path):
         assert proc.wait(timeout=60) == 141
 
 
-def _wait_for(predicate, timeout: float = 60.0) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if predicate():
-            return True
-        time.sleep(0.05)
-    return False
-
-
 @pytest.mark.render
 @pytest.mark.skipif(not HAS_RENDER, reason="needs the render extra")
 @pytest.mark.parametrize(("sig", "status", "word"), [(signal.SIGTERM, 143, "terminated"),
@@ -131,10 +114,18 @@ def test_signals_exit_with_one_line_and_no_temporary_files(tmp_path, sig, status
     out_dir.mkdir()
     proc = facelib_cmd("render", str(story), "-o", str(out_dir / "long.mp4"),
                        "--width", "160", "--height", "120")
-    assert _wait_for(lambda: any(out_dir.iterdir())), "the render never started writing"
-    time.sleep(0.3)
+    # ready: the first progress line ("rendering: 10% (50/500 frames, ...)") comes once
+    # frames are being encoded into the temporary file, 90 % of the render still to go
+    before = []
+    for line in iter(proc.stderr.readline, b""):
+        before.append(line.decode())
+        if line.startswith(b"rendering: "):
+            break
+    else:
+        pytest.fail("the render ended before its first progress line: " + "".join(before))
+    assert any(out_dir.iterdir()), "rendering, but no temporary file"
     proc.send_signal(sig)
-    err = proc.stderr.read().decode()
+    err = "".join(before) + proc.stderr.read().decode()
     assert proc.wait(timeout=60) == status, err
     assert err.strip().splitlines()[-1] == f"facelib: {word}"
     assert "Traceback" not in err
@@ -147,20 +138,21 @@ def test_a_signal_a_library_turned_into_another_error_still_exits_as_that_signal
     import argparse
     import ctypes
 
-    from facelib.cli import Console, _dispatch
+    from facelib.cli.console import Console
+    from facelib.cli.dispatch import dispatch
 
     def run(args, console):
         console.signals.received = signal.SIGTERM
         raise ctypes.ArgumentError("argument 2: Terminated: ")
 
-    assert _dispatch(run, argparse.Namespace(), Console()) == 143
+    assert dispatch(run, argparse.Namespace(), Console()) == 143
     assert capsys.readouterr().err.strip() == "facelib: terminated"
 
     def broken(args, console):
         raise ValueError("a bug, with no signal")
 
     with pytest.raises(ValueError, match="a bug"):
-        _dispatch(broken, argparse.Namespace(), Console())
+        dispatch(broken, argparse.Namespace(), Console())
 
 
 def test_exit_codes_are_documented():

@@ -4,6 +4,7 @@ import csv
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from facelib import read_fap
 from facelib.cli import main
@@ -11,6 +12,7 @@ from facelib.cli import main
 FAP = Path(__file__).parents[1] / "data" / "fap" / "xface.fap"
 
 
+@pytest.mark.slow  # every export of a storyboard
 def test_export_glb_html_and_arkit_then_import(tmp_path, capsys):
     assert main(["export", str(FAP), "-o", str(tmp_path / "x.glb"),
                  "--html", str(tmp_path / "page")]) == 0

@@ -93,6 +93,7 @@ def _poses(fap_frame) -> list[np.ndarray]:  # type: ignore[no-untyped-def]
             *(library.get(name).values for name in library.names)]
 
 
+@pytest.mark.slow  # every lid pose
 def test_lashes_never_pass_through_the_skin_or_the_eyeballs(face: Face,  # type: ignore[no-untyped-def]
                                                             fap_frame) -> None:
     ids = _lashes(face)

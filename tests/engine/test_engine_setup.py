@@ -141,6 +141,7 @@ def test_bad_meshes(source, tmp_path: Path) -> None:  # type: ignore[no-untyped-
         load_head_mesh(broken)
 
 
+@pytest.mark.render  # renders the set-up face
 def test_cli_face_setup_then_render(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
     out = tmp_path / "cartoon"
     assert main(["face", "setup", str(HEADS / "cartoon_head.obj"), "--landmarks",
@@ -179,6 +180,7 @@ def test_cli_bad_input_writes_nothing(tmp_path: Path, capsys) -> None:  # type: 
     assert not out.exists()
 
 
+@pytest.mark.slow  # two face set-ups
 def test_given_axes_turn_a_z_up_mesh(cartoon, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     mesh, marks = cartoon
     # a CAD-style copy: +z up, the face looking along -y

@@ -132,6 +132,7 @@ def test_d1_surface_points_map_to_themselves(face) -> None:  # type: ignore[no-u
                                atol=1e-15)
 
 
+@pytest.mark.slow  # brute force
 def test_d2_equals_brute_force(face) -> None:  # type: ignore[no-untyped-def]
     verts, tris = _skin(face)
     surf = surface(verts, tris)

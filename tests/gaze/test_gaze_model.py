@@ -33,6 +33,7 @@ def _truncated_exponential_cdf(x, lo, hi, scale):
     return (1 - np.exp(-(x - lo) / scale)) / (1 - math.exp(-(hi - lo) / scale))
 
 
+@pytest.mark.slow  # a long simulation
 def test_direction_bins_within_two_points_of_table():
     # Short intervals and no mutual gaze give many drawn saccades in one run (a look away
     # that would leave the allowed disk is shortened along its drawn direction).

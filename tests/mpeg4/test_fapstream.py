@@ -94,6 +94,22 @@ def test_resample_interpolates_linearly_and_keeps_duration(ramp):
     assert back == stream
 
 
+def test_at_whole_rate_resamples_to_the_nearest_whole_rate_a_fap_file_takes(ramp):
+    from facelib.mpeg4 import format_fap
+
+    stream = ramp(30, 25)
+    assert stream.at_whole_rate() is stream  # already whole: untouched
+    measured = stream.resample(29.97)  # a camera's measured rate
+    with pytest.raises(ParameterError, match="whole frame rate"):
+        format_fap(measured)
+    whole = measured.at_whole_rate()
+    assert whole.fps == 30.0
+    assert whole.duration == pytest.approx(measured.duration, abs=1 / 30)
+    assert whole == measured.resample(30)
+    assert format_fap(whole).count("\n") > 30
+    assert ramp(10, 12.5).at_whole_rate().fps == 12.0  # round half to even, as round()
+    assert ramp(3, 0.4).at_whole_rate().fps == 1.0  # never 0 fps
+
 def test_concat_and_equality(ramp):
     a, b = ramp(4), ramp(3)
     joined = FapStream.concat([a, b])

@@ -12,6 +12,8 @@ from facelib.cues import CameraCue
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 
+pytestmark = pytest.mark.render
+
 engine = pytest.importorskip("facelib.engine")
 W, H = 96, 72
 

@@ -7,6 +7,8 @@ import pytest
 
 from facelib.rendering.scene import FaceRenderer
 
+pytestmark = pytest.mark.render
+
 engine = pytest.importorskip("facelib.engine")
 W, H = 200, 200
 

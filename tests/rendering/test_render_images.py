@@ -10,6 +10,8 @@ from facelib.mpeg4.stream import FapStream
 from facelib.rendering.frames import render, render_still
 from facelib.rendering.scene import FaceRenderer
 
+pytestmark = pytest.mark.render
+
 W, H = 160, 120
 
 

@@ -10,6 +10,8 @@ import pytest
 from facelib.errors import FaceModelError, ParameterError
 from facelib.rendering.scene import FaceRenderer, downsample, load_look
 
+pytestmark = pytest.mark.render
+
 engine = pytest.importorskip("facelib.engine")
 
 

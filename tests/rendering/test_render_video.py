@@ -16,6 +16,8 @@ from facelib.errors import ParameterError, RenderError
 from facelib.rendering.frames import render
 from facelib.rendering.video import encode_png, open_writer, probe_video, save_png
 
+pytestmark = pytest.mark.render
+
 W, H = 96, 72
 
 

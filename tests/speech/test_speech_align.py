@@ -13,6 +13,8 @@ import soundfile
 from facelib.errors import PronunciationWarning, SpeechError
 from facelib.visemes import SpeechWarning, align, timeline_to_json
 
+pytestmark = pytest.mark.speech
+
 pytest.importorskip("pocketsphinx")
 
 FIXTURES = Path(__file__).parents[1] / "data" / "speech" / "alignment"

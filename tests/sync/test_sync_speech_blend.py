@@ -30,6 +30,7 @@ def test_per_fap_weights_come_from_the_data_file():
     assert (e[untouched], v[untouched]) == rules.mouth
 
 
+@pytest.mark.speech  # the demo's speech is force-aligned
 def test_smile_keeps_most_of_its_corner_lift_while_speaking(hello):
     """Joy 'with the word' (2.7-4.2 s, full between its ramps) while the mouth talks."""
     e, v, out = hello.tracks["expressions"], hello.tracks["visemes"], hello.faps
@@ -41,6 +42,7 @@ def test_smile_keeps_most_of_its_corner_lift_while_speaking(hello):
     assert kept >= 0.7
 
 
+@pytest.mark.speech  # the demo's speech is force-aligned
 def test_every_bilabial_of_the_demo_closes_the_lips(hello):
     face = engine.load_face(None)
     fp = face.feature_points
@@ -94,6 +96,7 @@ def test_per_fap_blend_is_eq_4_11_where_the_table_says_1_3():
     assert out.values[0, CORNERS[0]] == pytest.approx((4 * 100 + 300) / 5)
 
 
+@pytest.mark.speech  # the demo's speech is force-aligned
 def test_speech_nods_on_stressed_syllables_are_seeded_and_sized(hello):
     """Issue 14 item 8: nods of 2-5 degrees on the jaw-opening peaks while speaking."""
     import dataclasses

@@ -123,6 +123,7 @@ def brow_signal(values: np.ndarray) -> np.ndarray:
     return out + rng.normal(0, 1e-3, out.shape)
 
 
+@pytest.mark.slow  # learns from images
 def test_the_image_part_learns_what_the_landmarks_do_not_show():
     values = random_stream(400, seed=8)
     hidden = values.copy()

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from facelib.engine.headmesh import head_mesh, load_head_mesh
+from facelib.engine.headmesh import axes_rotation, head_mesh, load_head_mesh
 from facelib.engine.setup import read_landmarks, set_up_face
 from facelib.errors import FaceModelError
 
@@ -57,6 +57,23 @@ def test_cartoon_head_landmarks_within_3_mm() -> None:
     assert np.linalg.norm(found.points["2.1"] - truth["2.1"]) <= 3e-3  # type: ignore[attr-defined]
     assert np.sort(err)[-3] <= 6e-3
 
+
+
+def test_a_mesh_lying_on_its_back_is_searched_upright_and_answered_in_its_own_frame() -> None:
+    upright = load_head_mesh(HEADS / "soma_head.ply")
+    turn = axes_rotation("+z", "-y")  # the mesh looks down -y with +z up
+    lying = upright.rotated(turn.T)
+    with pytest.raises(FaceModelError, match="no face was found"):
+        detect_head_landmarks(lying)
+    found = detect_head_landmarks(lying, up="+z", forward="-y")
+    reference = detect_head_landmarks(upright)
+    assert found.points.keys() == reference.points.keys()
+    for fp, point in found.points.items():  # the same search, the points in lying's frame
+        np.testing.assert_array_equal(point, turn.T @ reference.points[fp])
+    face = set_up_face(lying, landmarks=found.as_json(), up="+z", forward="-y").face
+    np.testing.assert_allclose(
+        face.vertices, set_up_face(upright, landmarks=reference.as_json()).face.vertices,
+        atol=1e-6)
 
 def test_auto_landmarks_set_up_a_face() -> None:
     mesh = load_head_mesh(HEADS / "soma_head.ply")

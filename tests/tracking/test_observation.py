@@ -120,6 +120,7 @@ def test_packaged_model():
     assert (np.abs(model.pose_bounds) < np.radians(20)).all()   # corrections of a few degrees
 
 
+@pytest.mark.slow  # learns a model
 def test_a_region_reads_its_faps_from_its_landmarks_alone(learned):
     values = random_stream(400, seed=1)
     region = LandmarkRegion((23, 24), gaze_region().landmarks, 30)   # the eyes and outline

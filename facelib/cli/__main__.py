@@ -1,0 +1,7 @@
+"""``python -m facelib.cli``: the ``facelib`` command."""
+
+import sys
+
+from facelib.cli.dispatch import main
+
+sys.exit(main())

@@ -1,0 +1,59 @@
+"""``facelib export SOURCE``: glTF (.glb), ARKit curves (.csv/.json) or a web page."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from facelib.cli.console import EXIT_OK, Console, UsageError
+from facelib.cli.options import COMMON, chosen_face, read_source
+from facelib.cli.outputs import check_suffix
+
+
+def add(commands: Any) -> None:
+    export = commands.add_parser(
+        "export", parents=[COMMON],
+        help="export to glTF (.glb), ARKit curves (.csv/.json) or a web page")
+    export.add_argument("source", help="STORY.fdl or FILE.fap")
+    export.add_argument("-o", "--output",
+                        help="OUT.glb (glTF), or with --arkit OUT.csv (Live Link Face) / OUT.json")
+    export.add_argument("--arkit", action="store_true",
+                        help="write ARKit-52 blendshape curves instead of glTF")
+    export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
+    export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
+    export.add_argument("--seed", type=int)
+    export.set_defaults(run=_export)
+
+def _export(args: argparse.Namespace, console: Console) -> int:
+    import numpy as np
+
+    from facelib import export
+
+    if args.output is None and args.html is None:
+        raise UsageError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
+                         "or both")
+    if args.output is not None:
+        check_suffix(args.output, (".csv", ".json") if args.arkit else
+                     (".glb", ".csv", ".json"), "export")
+    face = chosen_face(args.face)
+    source = read_source(args.source, args.seed, console)
+    if args.output is not None:
+        suffix = Path(args.output).suffix.lower()
+        if args.arkit or suffix in (".csv", ".json"):
+            curves = export.export_arkit(source, args.output, face=face)
+            moving = curves.relative[curves.relative > 0]
+            fit = (f"; fit residual RMS {1000 * float(curves.residual.mean()):.2f} mm, "
+                   f"median relative {float(np.median(moving)):.2f}" if moving.size else "")
+            console.status(f"wrote {args.output} ({curves.n_frames} frames of 52 ARKit "
+                           f"weights{fit})")
+        else:
+            result = export.export_gltf(source, args.output, face=face, audio=args.audio)
+            audio = f", audio {result.audio}" if result.audio else ""
+            console.status(f"wrote {result.path} ({len(result.targets)} morph targets, "
+                           f"{result.n_frames} frames{audio})")
+    if args.html is not None:
+        page = export.export_html(source, args.html, face=face, audio=args.audio)
+        console.status(f"wrote {page.page} (open it in a browser)")
+    return EXIT_OK

@@ -1,0 +1,44 @@
+"""The options and inputs several commands share: ``-q``/``-v`` (:data:`COMMON`, the parent
+of every parser), ``--face`` and a SOURCE that is a storyboard or a ``.fap`` file."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from facelib.cli.console import Console
+from facelib.mpeg4 import read_fap
+
+COMMON = argparse.ArgumentParser(add_help=False)
+COMMON.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+                    help="print only errors")
+COMMON.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                    help="also print log messages, progress of every stage and tracebacks")
+
+
+def face_path(face: str | None) -> Path | None:
+    """``--face``: a face definition JSON, or the folder ``facelib face setup`` wrote."""
+    if face is None:
+        return None
+    path = Path(face)
+    return path / "face.json" if path.is_dir() else path
+
+
+def chosen_face(face: str | None) -> Any:
+    """The Face ``--face`` names, else the default head."""
+    from facelib.engine import default_face, load_face
+
+    path = face_path(face)
+    return default_face() if path is None else load_face(path)
+
+
+def read_source(path: str, seed: int | None, console: Console) -> Any:
+    """A storyboard's Animation, or a .fap file's stream."""
+    if Path(path).suffix.lower() == ".fap":
+        return read_fap(path)
+    from facelib.animation import run_fdl
+
+    return run_fdl(path, seed=seed,
+                   progress=console.progress("animating", unit="stages", show=console.verbose))
+
