@@ -24,6 +24,7 @@ from facelib.errors import MissingExtraError, ParameterError
 from facelib.export.audio import copy_audio
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, export_clip, face_of
+from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
 
 __all__ = ["GltfExport", "export_gltf"]
@@ -262,6 +263,19 @@ def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: P
     b.g.animations.append(animation)
 
 
+def _asset_extras(stream: FapStream, rows: np.ndarray, scales: np.ndarray,
+                  copied: Path | None, offset: float) -> dict[str, Any]:
+    """``asset.extras``: facelib's frame rate, frame count, audio and targets."""
+    return {"facelib": {
+        "fps": float(stream.fps), "n_frames": int(stream.n_frames),
+        "audio": copied.name if copied else None, "audio_offset": float(offset),
+        "targets": [{"fap": int(r) + 1, "name": fap(int(r) + 1).name, "scale": float(s)}
+                    for r, s in zip(rows, scales, strict=True)],
+        "_targets": "each target is a FAP's displacement at FAP value scale; a FAP with values "
+                    "of both signs has one target per sign, so every weight is in [0, 1]",
+        "joint_fractions": FRACTIONS}}
+
+
 def export_gltf(
     source: Source,
     out: str | os.PathLike[str],
@@ -297,14 +311,7 @@ def export_gltf(
     targets = (dense * scales[:, None, None]).astype(np.float32)
     copied = copy_audio(audio_path, out)
     g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
-    g.asset.extras = {"facelib": {
-        "fps": float(stream.fps), "n_frames": int(stream.n_frames),
-        "audio": copied.name if copied else None, "audio_offset": float(offset),
-        "targets": [{"fap": int(r) + 1, "name": fap(int(r) + 1).name, "scale": float(s)}
-                    for r, s in zip(rows, scales, strict=True)],
-        "_targets": "each target is a FAP's displacement at FAP value scale; a FAP with values "
-                    "of both signs has one target per sign, so every weight is in [0, 1]",
-        "joint_fractions": FRACTIONS}}
+    g.asset.extras = _asset_extras(stream, rows, scales, copied, offset)
     b = _Builder(g, lib)
     mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, targets),
                     weights=[0.0] * len(rows) if len(rows) else None)

@@ -114,9 +114,8 @@ def render(
         ``audio_offset`` seconds into the video (default ``source.audio_offset`` or 0):
         the audio rule of :mod:`facelib.clip`.
     background: sRGB colour behind the face (None: the look's). framing: see FaceRenderer.
-    progress: True reports on stderr (a bar on a terminal, a line per 10 % otherwise),
-        None/False is silent, a callable is called as ``progress(frames_done, n_frames)``.
-    fps: resample the stream to this frame rate first (None keeps the stream's).
+    progress: True reports on stderr, None/False is silent, a callable gets ``(frames_done,
+        n_frames)``. fps: resample the stream to this rate first (None keeps the stream's).
 
     Returns ``(n_frames, height, width, 3) uint8`` RGB frames when ``out`` is None, else the
     written path. The camera frames the neutral face; storyboard camera cues move it.

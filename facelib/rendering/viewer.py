@@ -122,9 +122,7 @@ def view(
     and right arrows step one frame (up/down: ten), q closes. With ``sound`` the speech
     audio of an animation (its file or its synthesized speech) plays in sync through
     pyglet where an audio device exists (silently otherwise); it stops on pause. The
-    window closes at the end unless ``loop``, which replays until it is closed. Blocks
-    until then.
-    """
+    window closes at the end unless ``loop`` (replays until closed). Blocks until then."""
     if not has_display():
         raise RenderError(
             "no display: DISPLAY and WAYLAND_DISPLAY are unset, so no window can open; "
