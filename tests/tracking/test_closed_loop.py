@@ -110,9 +110,9 @@ def test_lip_closures_come_back(which, hello, loop, soma_loop):
     # 1 of 3 without the closed mouth state). Every brief lip contact of the source (gap
     # under 0.1 MNS0 for at most 0.4 s, p/b/m and near-touches of other consonants): 3 of 3
     # on SOMA-X; on the default head 5 of 5 before issue 31's articulation, 4 of 7 since
-    # (its f/v now lift the lower lip to the upper teeth, two more near-touches that the
-    # tracker, trained on the old mouth, reads as parted: a regression noted for the
-    # tracking issue); 1 and no false closures
+    # (the new mouth shapes make two more near-touches, and the tracker, trained on the old
+    # mouth, misses three: a regression noted for the tracking issue); 1 and no false
+    # closures
     found, face = (loop, default_face()) if which == "default" else (soma_loop, soma_face())
     truth_gap = lip_gap(face, found.truth)
     pbm = bilabial_closures(truth_gap, bilabial_spans(hello.visemes), found.truth.fps)
