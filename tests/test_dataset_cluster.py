@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import pickle
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -110,6 +111,12 @@ def test_a_pickle_relayed_as_a_result_is_never_unpickled(cluster, tmp_path):
     with pytest.raises(FacelibError, match=r"clip [01]: the cluster sent <refused by "
                                            r"facelib: a pickle> instead of the clip's"):
         generate(SPEC, tmp_path / "ds", scheduler=cluster.scheduler_address)
+    # a Client of the caller's is not used as it is: facelib opens its own to its scheduler
+    import distributed
+
+    with distributed.Client(cluster.scheduler_address, set_as_default=False) as theirs, \
+            pytest.raises(FacelibError, match="refused by facelib: a pickle"):
+        generate(SPEC, tmp_path / "ds", scheduler=theirs)
     assert not _pwned(mark)
 
 
@@ -281,3 +288,48 @@ def test_the_command_refuses_a_remote_scheduler_over_tcp(tmp_path):
                               capture_output=True, text=True, timeout=120)
         assert done.returncode != 0
         assert expected in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def _certificates(folder: Path) -> dict[str, str]:
+    """A CA and one certificate signed by it (for the cluster and the client alike)."""
+    def openssl(*args: str) -> None:
+        subprocess.run(["openssl", *args], check=True, capture_output=True, timeout=60)
+
+    ca, ca_key, cert, key, request = (str(folder / n) for n in (
+        "ca.pem", "ca.key", "cert.pem", "cert.key", "cert.csr"))
+    openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", ca_key, "-out", ca,
+            "-days", "2", "-subj", "/CN=facelib test CA")
+    openssl("req", "-newkey", "rsa:2048", "-nodes", "-keyout", key, "-out", request,
+            "-subj", "/CN=127.0.0.1")
+    openssl("x509", "-req", "-in", request, "-CA", ca, "-CAkey", ca_key, "-CAcreateserial",
+            "-out", cert, "-days", "2")
+    return {"ca": ca, "cert": cert, "key": key}
+
+
+@pytest.mark.cluster
+@pytest.mark.skipif(not shutil.which("openssl"), reason="needs openssl to make certificates")
+def test_a_tls_cluster_is_reached_with_the_plain_data_client(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    from facelib.cluster import tls_security
+
+    files = _certificates(tmp_path)
+    security = tls_security(**files)
+    roles = {f"tls_{role}_{part}": files[part] for role in ("scheduler", "worker", "client")
+             for part in ("cert", "key")}
+    cluster_security = distributed.Security(tls_ca_file=files["ca"], require_encryption=True,
+                                            **roles)
+    mark = tmp_path / "mark"
+    mark.mkdir()
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, protocol="tls://",
+                                  security=cluster_security) as cluster:
+        assert cluster.scheduler_address.startswith("tls://")
+        with pytest.raises(ParameterError, match="needs the cluster's certificates"):
+            generate(SPEC, tmp_path / "ds", scheduler=cluster.scheduler_address)
+        with distributed.Client(cluster.scheduler_address, security=cluster_security,
+                                set_as_default=False) as setup:
+            setup.run(exec, _HOSTILE_RESULT % {"mark": str(mark)}, {})
+        with pytest.raises(FacelibError, match="refused by facelib: a pickle"):
+            generate(SPEC, tmp_path / "ds", scheduler=cluster.scheduler_address,
+                     security=security)
+    assert not _pwned(mark)
