@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "facelib"
 BASE = {"errors", "checks", "atomic", "data", "progress"}
 GENERATORS = {"fdl", "speech", "visemes", "expressions", "gaze"}
 OUTPUTS = {"rendering", "tracking", "export"}
-TOP = {"batch", "dataset", "evaluate", "catalog", "cli", "plot", "__init__", "__main__"}
+TOP = {"batch", "cluster", "dataset", "evaluate", "catalog", "cli", "plot", "__init__", "__main__"}
 
 # unit -> the facelib units it may import (besides itself)
 ALLOWED: dict[str, set[str]] = {
