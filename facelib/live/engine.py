@@ -123,18 +123,21 @@ class Engine:
     def add_speech(self, timeline: SpeechTimeline, audio: SpeechAudio | None, *,
                    playback: SpeechAudio | None = None,
                    text: str | None = None, at_ms: int | None = None,
-                   style: str | float = "normal", replace_last: bool = False) -> int:
+                   style: str | float = "normal", replace_last: bool = False,
+                   lead_ms: int | None = None) -> int:
         """Place speech with a known ``timeline`` (its own ms) and ``audio`` no earlier than
         now plus the envelope's ramp and after the speech already placed (``replace_last``:
         instead of the last utterance, at its start: streamed audio that grew). ``audio``
         drives the jaw; ``playback`` (default ``audio``) is what :meth:`audio` plays.
-        Returns its start (session ms)."""
+        ``lead_ms`` (default: the ramp) shortens the lead for streamed audio, whose mouth
+        then starts from where the frames out left it. Returns its start (session ms)."""
         plan = self._epoch.plan
         utterances = list(plan.utterances)
         if replace_last and utterances:
             start = round(self.frame_ms(self._epoch.start)) + utterances.pop().start_ms
         else:
-            start = max(self.place(at_ms, lead_ms=self.lead_ms), self.speech_end_ms)
+            lead = self.lead_ms if lead_ms is None else lead_ms
+            start = max(self.place(at_ms, lead_ms=lead), self.speech_end_ms)
         spec = SpeechSpec(text=text, start_ms=self._local(start), style=style)
         animation = animate_spoken(spec, timeline, audio, fps=self.fps)
         utterances.append(Utterance(self._local(start), timeline, animation, audio, text,

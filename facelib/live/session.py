@@ -173,7 +173,7 @@ class Session:
         if self._listener.n_samples == 0:
             at = engine.now_ms + self.lookahead_ms if gap else self._audio_next_ms
             timeline, sound = await asyncio.to_thread(self._listener.feed, samples)
-            start = engine.add_speech(timeline, sound, at_ms=at)
+            start = engine.add_speech(timeline, sound, at_ms=at, lead_ms=self.lookahead_ms)
         else:
             timeline, sound = await asyncio.to_thread(self._listener.feed, samples)
             start = engine.add_speech(timeline, sound, replace_last=True)
