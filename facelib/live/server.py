@@ -214,6 +214,8 @@ async def _serve_session(ws: Any, session: Session, outputs: set[str],
                         break
                 except Exception as exc:  # noqa: BLE001 - every bad message is answered
                     await error(exc)
+            else:  # the client went away: end the session now
+                await session.close()
             await pump
         finally:
             pump.cancel()
