@@ -31,6 +31,8 @@ ALLOWED: dict[str, set[str]] = {
     "engine": BASE | {"mpeg4"},
     "clip": BASE | {"mpeg4", "engine"},
     **{unit: BASE | {"mpeg4", "engine", "clip"} for unit in OUTPUTS},
+    # live sessions: on the layer of animation, plus the outputs they stream (DESIGN.md)
+    "live": BASE | {"mpeg4", "cues", "sync", "animation", "export", "clip"} | GENERATORS,
 }
 ALLOWED["visemes"] = ALLOWED["visemes"] | {"speech"}
 ALLOWED["tracking"] = ALLOWED["tracking"] | {"rendering"}  # landmarks found on a render
