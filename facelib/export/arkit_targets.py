@@ -4,7 +4,8 @@ deformed by it.
 A recipe is the FAP frame (84 values, FAP units) that plays one ARKit shape at weight 1:
 
 * a ``shape`` blendshape: the FAPs that :func:`facelib.export.from_arkit` gives for that
-  weight alone (the default head's least-squares map from its MakeHuman ARKit sculpts);
+  weight alone (the default head's least-squares map from its MakeHuman ARKit sculpts plus
+  the learned correction);
 * an eye look (``angle``): the eye yaw or pitch FAP at the angle of weight 1
   (``export/arkit.json`` ``eye_look_full_deg``);
 * ``TongueOut``: the tongue-tip thrust (FAP 45) that puts the tip the full reach past the
@@ -22,7 +23,7 @@ import numpy as np
 
 from facelib import data
 from facelib.engine import Face
-from facelib.export.arkit import _THRUST, _basis, arkit_names
+from facelib.export.arkit import _THRUST, _basis, _correction, arkit_names
 
 __all__ = ["arkit_recipes", "arkit_shape_targets", "arkit_target_names"]
 
@@ -44,7 +45,7 @@ def arkit_recipes() -> np.ndarray:
     """``(52, 84) float32``: the FAP frame of each ARKit shape at weight 1 (module doc),
     rows in :func:`arkit_names` order."""
     face, basis = _basis(None)
-    out = basis.to_faps.T.astype(np.float64).copy()
+    out = basis.to_faps.T.astype(np.float64) + _correction()
     au = face.fapu["AU"]
     full = data.json_data("export/arkit.json")["eye_look_full_deg"]
     names = arkit_names()

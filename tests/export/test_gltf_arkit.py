@@ -81,7 +81,7 @@ def test_the_file_plays_what_the_arkit_round_trip_plays(exported):
             ids = np.sort(face.parts[name].vertex_ids)
             worst[name] = max(worst.get(name, 0.0), float(np.abs(got - want[frame][ids]).max()))
     print({k: f"{1000 * v:.2f} mm" for k, v in worst.items()})
-    assert worst["skin"] < 1e-3 and worst["teeth_upper"] < 1e-5
+    assert worst["skin"] < 2e-3 and worst["teeth_upper"] < 1e-5
     assert max(worst.values()) < 3e-3
     # the animation is real: frame 6 moves the skin by millimetres
     assert np.abs(want[6] - face.vertices).max() > 0.005
