@@ -130,7 +130,7 @@ def cap(head: dict, spec: dict, colour: np.ndarray) -> dict:
     above it kept and lifted off the skin."""
     tris = head["skin_t"]
     near = (above_hairline(head["v"], head, spec)[tris] > -0.02).any(1)
-    pos, nrm, sub = subdivide(head["v"], head["normals"], tris[near], 4)
+    pos, nrm, sub = subdivide(head["v"], head["normals"], tris[near], 3)
     above = above_hairline(pos, head, spec)
     keep = sub[(above[sub] > 0).all(1)]
     ids = np.unique(keep)
@@ -161,7 +161,7 @@ def flow(style: dict, p: np.ndarray) -> np.ndarray:
     if kind == "back":
         up = np.clip((p[:, 1] - 0.06) / 0.06, 0, 1)[:, None]
         side = np.sign(p[:, 0])[:, None] * np.array([1.0, 0, 0])
-        d = up * np.array([0, 0.1, -1.0]) + (1 - up) * (DOWN + 0.5 * np.array([0, 0, -1.0])
+        d = up * np.array([0, 0.1, -1.0]) + (1 - up) * (DOWN + 0.9 * np.array([0, 0, -1.0])
                                                          + 0.2 * side)
     elif kind == "part":
         part = style["part_x_mm"] / 1000
