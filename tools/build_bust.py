@@ -222,13 +222,16 @@ def build() -> tuple[dict[str, np.ndarray], np.ndarray]:
     g_rgb = np.where(collar[:, None], COLLAR_RGB, GARMENT_RGB) * 255
     colours = np.concatenate([skin_rgb.reshape(-1, 3), g_rgb])
     ao = bake_ao(head_v, head_t, vertices, triangles)
+    # the head's own occlusion at the seam carries on down the neck, blending into the bake
+    skin_ao = ao[:len(skin_v)].reshape(len(SAMPLES), n_cols)
+    blend = np.clip(SAMPLES / 3.0, 0, 1)[:, None]
+    skin_ao[:] = (1 - blend) * (head_ao[loop_ids] / 255.0)[None] + blend * skin_ao
     arrays = {"vertices": vertices, "triangles": triangles,
               "vertex_colors": np.clip(np.round(colours), 0, 255).astype(np.uint8),
               "vertex_ao": np.round(ao * 255).astype(np.uint8),
               "base": np.array(base, np.int64), "seam": loop_ids.astype(np.int32),
               "seam_vertices": head_v[loop_ids].astype(np.float32),
               "garment_start": np.array(len(skin_v), np.int64)}
-    del head_ao
     return arrays, head_c
 
 

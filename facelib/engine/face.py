@@ -620,13 +620,16 @@ def _lids(
 
 def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
            ) -> dict[str, Part]:
-    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it."""
+    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it; an
+    attached part (appended after the head) also takes the triangles that join it to the
+    head, those whose last vertex is its own."""
     out = {}
     for name, part_ids in parts.items():
         ids = _readonly(part_ids, np.int32)
         inside = np.zeros(n_vertices, bool)
         inside[ids] = True
-        out[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+        mine = inside[tris.max(1)] if name in ATTACHED_PARTS else inside[tris].all(1)
+        out[name] = Part(name, ids, _readonly(tris[mine], np.int32))
     return out
 
 

@@ -41,7 +41,9 @@ def _scalp_points(face, vertices: np.ndarray, renderer: FaceRenderer) -> np.ndar
     to_camera = renderer.camera_pose[:3, 3] - vertices[skin]
     to_camera /= np.linalg.norm(to_camera, axis=1, keepdims=True)
     facing = np.einsum("ij,ij->i", normals, to_camera) > 0.4
-    pick = skin[(above > ABOVE_MM / 1000) & facing]
+    # above y = 6 cm only: the mouth's cavity lies behind the head's centre too, where the
+    # hairline is low (the nape)
+    pick = skin[(above > ABOVE_MM / 1000) & facing & (rest[:, 1] > 0.06)]
     pixels = np.round(renderer.project(vertices[pick])).astype(int)
     inside = (pixels[:, 0] >= 0) & (pixels[:, 0] < W) & (pixels[:, 1] >= 0) & (pixels[:, 1] < H)
     return pixels[inside]
@@ -63,7 +65,7 @@ def test_no_scalp_skin_shows_above_the_hairline(bald, style, framing) -> None:
             points = _scalp_points(bald, bare, renderer)
         with FaceRenderer(bald, width=W, height=H, framing=framing) as renderer:
             skin = renderer.frame(bare).astype(int)
-        assert len(points) > 15
+        assert len(points) > 10
         at_hair = haired[points[:, 1], points[:, 0]]
         at_skin = skin[points[:, 1], points[:, 0]]
         # where the bald head shows scalp skin, the haired one shows something else, darker
