@@ -98,12 +98,13 @@ def ring_points(loop: np.ndarray) -> np.ndarray:
     theta = np.arctan2(rel[:, 0], rel[:, 2])
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
     out = [loop]
-    for k, (y, tilt, a, b, n, zc) in enumerate(RINGS):
+    for k, (y, tilt, a, b, n, ring_z) in enumerate(RINGS):
         r = superellipse_radius(theta, a, b, n)
+        zc = ring_z
         if k < len(LOOP_SHAPE):
             w = LOOP_SHAPE[k]
             r = w * r_loop + (1 - w) * r
-            zc = w * centre[2] + (1 - w) * zc
+            zc = w * centre[2] + (1 - w) * ring_z
         heights = y + tilt * np.cos(theta)
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
     return np.array(out)
@@ -138,8 +139,8 @@ def garment(spline: CubicSpline, theta: np.ndarray
     end = float(len(RINGS))
     tuck, rib, rib_h = COLLAR
     rows = [(start, tuck, True), (start, rib, True), (start + rib_h, rib, True)]
-    for s in np.linspace(0, 1, 22)[1:]:
-        rows.append((start + rib_h + s ** 1.6 * (end - start - rib_h), GARMENT_OFFSET, False))
+    rows.extend((start + rib_h + s ** 1.6 * (end - start - rib_h), GARMENT_OFFSET, False)
+                for s in np.linspace(0, 1, 22)[1:])
     verts, flags = [], []
     columns = np.arange(len(theta))
     for ks, offset, collar in rows:

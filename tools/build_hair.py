@@ -152,7 +152,8 @@ def sample_roots(cap_mesh: tuple, count: int, rng: np.random.Generator) -> np.nd
     pick = rng.choice(len(t), size=count, p=area / area.sum())
     r1, r2 = rng.random(count), rng.random(count)
     s = np.sqrt(r1)
-    return (1 - s)[:, None] * a[pick] + (s * (1 - r2))[:, None] * b[pick] + (s * r2)[:, None] * c[pick]
+    return ((1 - s)[:, None] * a[pick] + (s * (1 - r2))[:, None] * b[pick]
+            + (s * r2)[:, None] * c[pick])
 
 
 def flow(style: dict, p: np.ndarray) -> np.ndarray:

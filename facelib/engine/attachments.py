@@ -48,7 +48,7 @@ def _colours(values: np.ndarray) -> np.ndarray:
     return np.clip(np.asarray(out, np.float64), 0.0, 1.0)
 
 
-def _checked(name: str, where: Path, vertices: np.ndarray, triangles: np.ndarray,
+def _checked(name: str, where: Path, vertices: np.ndarray, triangles: np.ndarray, *,
              colours: np.ndarray, ao: np.ndarray, base: int) -> None:
     total = base + len(vertices)
     if vertices.ndim != 2 or vertices.shape[1] != 3 or not np.all(np.isfinite(vertices)):
@@ -79,7 +79,7 @@ def _bust(where: Path, head: np.ndarray) -> Attachment:
             head[seam], seam_at, atol=1e-6):
         raise FaceModelError(f"this bust was built for another head ({base} vertices, its "
                              f"seam elsewhere); this head has {len(head)}", path=where)
-    _checked("bust", where, v, t, c, ao, base)
+    _checked("bust", where, v, t, colours=c, ao=ao, base=base)
     return Attachment(base, v, t, c, ao, {"bust": (0, split), "garment": (split, len(v))})
 
 
@@ -101,7 +101,7 @@ def _hair(where: Path, style: str, base: int) -> Attachment:
         uv = data[f"{style}_uv"].astype(np.float32)
     except KeyError as exc:
         raise FaceModelError(f"the hair mesh lacks the array {exc.args[0]!r}", path=where) from None
-    _checked("hair", where, v, t, c, ao, base)
+    _checked("hair", where, v, t, colours=c, ao=ao, base=base)
     if uv.shape != (len(v), 2) or not np.all(np.isfinite(uv)):
         raise FaceModelError(f"hair uv must be finite ({len(v)}, 2), got {uv.shape}", path=where)
     return Attachment(base, v, t, c, ao, {"hair": (0, len(v))}, uv)
