@@ -21,7 +21,7 @@ from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.progress import ProgressCallback, progress_callback
-from facelib.sync import SyncRules, combine
+from facelib.sync import Liveliness, SyncRules, combine
 from facelib.visemes.animate import SpeechAudio, VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
 
@@ -76,6 +76,7 @@ def animate(
     storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
     max_frames: int = MAX_FRAMES,
     progress: bool | ProgressCallback | None = None,
+    liveliness: Liveliness | None = None,
 ) -> Animation:
     """Run the generators of a storyboard and resolve their conflicts.
 
@@ -86,12 +87,15 @@ def animate(
     :data:`facelib.cues.MAX_FRAMES`); a longer storyboard raises ParameterError before
     anything is computed. ``progress`` (see :mod:`facelib.progress`) is called after each
     of the four stages (speech, expressions, gaze, synchronizer) as ``progress(done, 4)``.
+    ``liveliness`` scales breathing, listening motion, micro-movements and the blink rate
+    (:class:`facelib.sync.Liveliness`; default: the data's numbers).
     An error of a generator that names no file is raised again naming the storyboard (and
     the line of the definition it concerns, where one can be found).
     """
     try:
         return _animate(storyboard, seed=seed, rules=rules, max_frames=max_frames,
-                        report=progress_callback(progress, "animating", unit="stages"))
+                        report=progress_callback(progress, "animating", unit="stages"),
+                        liveliness=liveliness or Liveliness())
     except FacelibError as exc:
         if exc.path is not None or storyboard.path is None:
             raise
@@ -101,7 +105,7 @@ def animate(
 
 def _animate(
     storyboard: Storyboard, *, seed: int | None, rules: SyncRules | None, max_frames: int,
-    report: ProgressCallback | None,
+    report: ProgressCallback | None, liveliness: Liveliness,
 ) -> Animation:
     def step(done: int) -> None:
         if report is not None:
@@ -138,11 +142,12 @@ def _animate(
     )
     step(2)
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
-                        behaviours=storyboard.gaze_defs, speaking=speaking)
+                        behaviours=storyboard.gaze_defs, speaking=speaking,
+                        blink_rate=liveliness.blink_rate)
     step(3)
     stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
                      blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=speaking,
-                     rules=rules, seed=storyboard.seed)
+                     rules=rules, seed=storyboard.seed, liveliness=liveliness)
     step(4)
     return Animation(
         faps=stream,
