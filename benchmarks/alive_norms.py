@@ -17,7 +17,7 @@ from facelib import animate, fap
 from facelib.fdl import loads
 from facelib.gaze import simulate
 from facelib.gaze.norms import blink_norms
-from facelib.sync import Liveliness
+from facelib.sync import Liveliness, SyncRules
 
 DEG = np.pi / 180 / 1e-5  # angle units per degree
 FPS = 25
@@ -80,7 +80,8 @@ def look18() -> None:
 def breathing() -> None:
     sb = loads(f'fps = {FPS}\nseed = 1\nlook {{ "default", "listening", dur = 120 }}')
     values = animate(sb).faps.values
-    still = animate(sb, liveliness=Liveliness(listening_amplitude=0.0)).faps.values
+    still = animate(sb, rules=SyncRules(head_noise=None),
+                    liveliness=Liveliness(listening_amplitude=0.0)).faps.values
     nose = values[:, fap("stretch_l_nose").index]
     pulses = np.count_nonzero((nose[1:] > 0) & (nose[:-1] <= 0))
     pitch = still[:, fap("head_pitch").index].astype(np.float64)
@@ -89,7 +90,7 @@ def breathing() -> None:
     band = (freq > 0.15) & (freq < 0.5)
     peak = freq[band][np.argmax(spectrum[band])] * 60
     print(f"breathing in the stream (120 s listening): {pulses / 2:.1f} nostril pulses/min; "
-          f"head pitch spectrum peak in 9-30/min at {peak:.1f}/min (listening motion off)")
+          f"head pitch spectrum peak in 9-30/min at {peak:.1f}/min (head noise and listening motion off)")
 
 
 def main() -> None:

@@ -183,3 +183,13 @@ def test_inner_brows_come_back_with_the_image(expressive_loops):
             assert loop.correlation(fap_id) > 0.9, fap_id
             alone = np.corrcoef(loop.truth.values[:, fap_id - 1], plain[:, fap_id - 1])[0, 1]
             assert loop.correlation(fap_id) > alone + 0.05, fap_id
+
+
+def test_a_neutral_start_is_kept_as_the_neutral(loop, soma_loop):
+    """With no neutral given, speech with lip presses and head turns keeps its first frame
+    (facelib.tracking.neutral: presses read as a jaw closing in too few frames)."""
+    from facelib.tracking.faps import find_neutral
+
+    for one in (loop, soma_loop):
+        points = np.concatenate([one.lead, one.landmarks])
+        assert not find_neutral(points, fps=one.truth.fps).searched
