@@ -90,7 +90,8 @@ def breathing() -> None:
     band = (freq > 0.15) & (freq < 0.5)
     peak = freq[band][np.argmax(spectrum[band])] * 60
     print(f"breathing in the stream (120 s listening): {pulses / 2:.1f} nostril pulses/min; "
-          f"head pitch spectrum peak in 9-30/min at {peak:.1f}/min (head noise and listening motion off)")
+          f"head pitch spectrum peak in 9-30/min at {peak:.1f}/min (head noise and listening "
+          f"motion off)")
 
 
 def main() -> None:
