@@ -19,6 +19,7 @@ from facelib.speech.align import OnImplausible
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.dtw import align_dtw as align_phones_dtw
 from facelib.speech.loudness import FLOOR_DB, window_loudness
+from facelib.speech.recognize import recognize
 from facelib.speech.synth import DEFAULT_LANGUAGE
 from facelib.speech.synth import synthesize as synthesize_speech
 from facelib.speech.timeline import PhoneTimeline
@@ -108,7 +109,8 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0,
     """The timeline of ``speech`` in its own time (ms from ``speech.start_ms``): a stored
     viseme script as it is; audio and text by forced alignment (English: pocketsphinx,
     falling back to DTW; other languages: DTW against espeak-ng); audio alone by
-    phone-loop recognition (English); text alone synthesized by espeak-ng. ``rate``
+    recognition (English words, then the phone loop; see
+    :func:`facelib.speech.recognize.recognize`); text alone synthesized by espeak-ng. ``rate``
     multiplies ``speech.rate``; ``language`` is the storyboard's (``speech.lang`` wins)."""
     return _spoken(speech, rate=rate, language=language)[0]
 
@@ -150,18 +152,17 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
 
 
 def _recorded(audio: Path, text: str | None, lang: str, voice: str | None) -> PhoneTimeline:
-    """Phones of recorded ``audio``: pocketsphinx for English (DTW if it fails), DTW
-    against the synthesized transcript for any other language."""
+    """Phones of recorded ``audio``: with a transcript, pocketsphinx for English (DTW if it
+    fails) and DTW against the synthesized transcript for any other language; without one,
+    recognition (:func:`facelib.speech.recognize.recognize`: English words, then the phone
+    loop; a clear SpeechError for a language without a model)."""
+    if text is None:
+        return recognize(audio, language=lang)
     if lang.lower().startswith("en"):
         try:
             return align_phones(audio, text)
         except SpeechError:
-            if text is None:
-                raise
             return align_phones_dtw(audio, text, lang=lang, voice=voice)
-    if text is None:
-        raise SpeechError(f"speech audio in {lang!r} needs its transcript (recognition without "
-                          "one is English only)", path=audio)
     return align_phones_dtw(audio, text, lang=lang, voice=voice)
 
 
@@ -183,6 +184,21 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     own, audio = _spoken(speech, rate=rate, language=language)
+    if audio is not None:
+        sound: tuple[np.ndarray, int] | None = (audio.samples, audio.sample_rate)
+    elif speech.audio is not None and own.phones:
+        sound = load_speech(speech.audio), ALIGN_RATE
+    else:
+        sound = None
+    return curves(own, speech, fps=fps, sound=sound, audio=audio, max_frames=max_frames)
+
+
+def curves(own: SpeechTimeline, speech: SpeechSpec, *, fps: float,
+           sound: tuple[np.ndarray, int] | None, audio: SpeechAudio | None = None,
+           max_frames: int = MAX_FRAMES) -> VisemeAnimation:
+    """The FAP curves of :func:`animate` for the timeline ``own`` (ms from the speech's
+    start) of ``speech`` (its ``start_ms``, ``style`` and ``origin``); ``sound`` is the
+    speech's ``(samples, sample_rate)`` for the loudness (None: none)."""
     timeline = own.shifted(speech.start_ms)
     # through the envelope's release ramp, so the mouth is seen settling back to neutral
     end_ms = speech.start_ms + timeline.duration_ms + timing_rules()["envelope_ramp_ms"]
@@ -192,7 +208,7 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
         raise SpeechError(f"speech lasts {end_ms} ms = {n_frames} frames at {fps:g} fps, more "
                           f"than max_frames={max_frames}", path=path, line=line)
     times = frame_times_ms(n_frames, fps)
-    loudness = _frame_loudness(speech, own, audio, times - speech.start_ms)
+    loudness = _frame_loudness(own, sound, times - speech.start_ms)
     env = envelope(timeline.visemes, times)
     gain = jaw_gain(loudness, rules=loudness_rules())
     levels = _levels(speech, timeline)
@@ -214,19 +230,16 @@ def _levels(speech: SpeechSpec, timeline: SpeechTimeline) -> np.ndarray:
         raise SpeechError(f"say: {exc.message}", path=path, line=line) from exc
 
 
-def _frame_loudness(speech: SpeechSpec, timeline: SpeechTimeline, audio: SpeechAudio | None,
+def _frame_loudness(timeline: SpeechTimeline, sound: tuple[np.ndarray, int] | None,
                     times_ms: np.ndarray) -> np.ndarray:
     """``(n_frames,) float32`` dBFS of the speech around each frame (times in the speech's
-    own ms): the RMS level over the ``loudness_window_ms`` centred on the frame, so the jaw
-    follows the speech envelope within a phone as well as from phone to phone; the floor
-    outside phones and where there is no audio."""
+    own ms): the RMS level of ``sound`` (samples, rate) over the ``loudness_window_ms``
+    centred on the frame, so the jaw follows the speech envelope within a phone as well as
+    from phone to phone; the floor outside phones and where there is no sound."""
     out = np.full(times_ms.size, FLOOR_DB, np.float32)
     phones = timeline.phones
-    if phones and (audio is not None or speech.audio is not None):
-        if audio is not None:
-            samples, sample_rate = audio.samples, audio.sample_rate
-        else:
-            samples, sample_rate = load_speech(speech.audio), ALIGN_RATE  # type: ignore[arg-type]
+    if phones and sound is not None:
+        samples, sample_rate = sound
         half = loudness_rules()["window_ms"] / 2
         centre = np.round(times_ms).astype(np.int64)
         levels = window_loudness(samples, sample_rate=sample_rate,
