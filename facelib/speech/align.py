@@ -66,10 +66,9 @@ def align(
     audio:
         A sound file in any format soundfile reads, or an array (then give ``sample_rate``).
     text:
-        The transcript. With it: forced alignment (``source="forced"``). Without:
-        :func:`facelib.speech.recognize.recognize` (English): the words are decoded, then
-        aligned (``source="recognized"``, each word with its ``confidence``), or where no
-        word is heard, phone-loop recognition (``source="phone-loop"``, no words).
+        The transcript. With it: forced alignment (``source="forced"``). Without: English
+        speech recognised by :func:`facelib.speech.recognize.recognize` (words decoded,
+        then aligned; the phone loop where no word is heard).
     on_implausible:
         What to do when the alignment looks wrong (a phone three times its usual length, a
         word squeezed to the minimum duration, a very poor acoustic score, a pause that

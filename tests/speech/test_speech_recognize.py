@@ -14,7 +14,6 @@ import facelib
 from facelib.cli import main
 from facelib.cues import SpeechSpec
 from facelib.errors import SpeechError
-from facelib.speech import synthesize
 from facelib.speech.recognize import piece_bounds, recognize
 from facelib.visemes import align, animate, speech_timeline, with_visemes
 
@@ -62,16 +61,14 @@ def test_festival_sentence_without_text_closes_on_every_pbm():
     assert all(w.confidence is None for w in timeline.words if w.label == "SIL")
 
 
-def test_espeak_sentence_without_text_closes_on_every_pbm():
-    """An espeak-ng sentence of many bilabials: every p/b/m of espeak-ng's own phone times
-    is closed by the recognised visemes, with at most one closure too many."""
-    made = synthesize("Bob made a map of the big pump by the moor.", lang="en")
-    truth = [(p.start_ms, p.end_ms) for p in made.timeline.phones if p.label in ("p", "b", "m")]
-    assert len(truth) >= 8
-    got = with_visemes(recognize(np.asarray(made.samples), sample_rate=made.sample_rate))
-    assert got.source == "recognized"
-    found, false = _closures_found(truth, got.visemes)
-    assert found >= len(truth) - 1 and false <= 1
+def test_many_bilabials_without_text():
+    """'Bob made a map of the big pump by the moor.' (Festival): of its 11 p/b/m phones
+    (measured: 10 closed, none false; 'pump by' was heard as 'come to buy')."""
+    timeline = with_visemes(recognize(FIXTURES / "bilabials.flac"))
+    assert timeline.source == "recognized"
+    truth = _truth_bilabials("bilabials")
+    found, false = _closures_found(truth, timeline.visemes)
+    assert len(truth) == 11 and found >= 9 and false <= 1
 
 
 def test_phone_loop_takes_over_when_no_word_is_heard():
