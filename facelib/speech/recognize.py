@@ -162,7 +162,7 @@ def _word_decoder(settings: Any) -> Any:
 
         raise MissingExtraError("speech recognition", "speech", "pocketsphinx") from exc
     return Decoder(bestpath=True, loglevel="FATAL", frate=round(1000 / settings["frame_ms"]),
-                   wlen=settings["window_ms"] / 1000)
+                   wlen=settings["window_ms"] / 1000, lw=settings["language_weight"])
 
 
 def piece_bounds(samples: np.ndarray) -> list[tuple[int, int]]:

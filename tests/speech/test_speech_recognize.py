@@ -4,6 +4,7 @@ fallback, per-word confidences, and the same path from the API, the CLI and a st
 from __future__ import annotations
 
 import json
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -142,3 +143,20 @@ def test_long_audio_is_cut_in_its_quietest_moment():
                                            pytest.approx(50250, abs=200)]
     assert bounds[0][0] == 0 and bounds[-1][1] == 70000
     assert all(b - a <= 30000 for a, b in bounds)
+
+
+@pytest.mark.slow
+def test_long_recording_is_recognised_in_pieces():
+    """Eleven readings of the fox sentence with 0.6 s pauses (40 s): two pieces, words
+    in both, times continuous across the cut, 22 closures (two per reading)."""
+    samples, rate = soundfile.read(str(FIXTURES / "quick_fox.flac"))
+    gap = np.zeros(round(0.6 * rate))
+    long = np.concatenate([np.concatenate([samples, gap]) for _ in range(11)])
+    assert rate == RATE and len(piece_bounds(long)) == 2
+    timeline = with_visemes(recognize(long, sample_rate=rate))
+    assert timeline.source == "recognized"
+    assert timeline.phones[-1].end_ms == timeline.duration_ms == round(1000 * long.size / rate)
+    assert all(a.end_ms == b.start_ms for a, b in pairwise(timeline.phones))
+    spoken = [w for w in timeline.words if w.label != "SIL"]
+    assert spoken[0].start_ms < 1000 and spoken[-1].end_ms > timeline.duration_ms - 3000
+    assert 20 <= sum(v.is_bilabial for v in timeline.visemes) <= 24
