@@ -37,8 +37,8 @@ from facelib.visemes.scripts import visemes_from_cues
 from facelib.visemes.tables import loudness_rules, timing_rules
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
-__all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate",
-           "speech_timeline", "synthesize", "timeline_from_text"]
+__all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate", "animate_spoken",
+           "speech_timeline", "spoken", "synthesize", "timeline_from_text"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -184,21 +184,27 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     own, audio = _spoken(speech, rate=rate, language=language)
-    if audio is not None:
-        sound: tuple[np.ndarray, int] | None = (audio.samples, audio.sample_rate)
-    elif speech.audio is not None and own.phones:
-        sound = load_speech(speech.audio), ALIGN_RATE
-    else:
-        sound = None
-    return curves(own, speech, fps=fps, sound=sound, audio=audio, max_frames=max_frames)
+    return animate_spoken(speech, own, audio, fps=fps, max_frames=max_frames)
 
 
-def curves(own: SpeechTimeline, speech: SpeechSpec, *, fps: float,
-           sound: tuple[np.ndarray, int] | None, audio: SpeechAudio | None = None,
-           max_frames: int = MAX_FRAMES) -> VisemeAnimation:
-    """The FAP curves of :func:`animate` for the timeline ``own`` (ms from the speech's
-    start) of ``speech`` (its ``start_ms``, ``style`` and ``origin``); ``sound`` is the
-    speech's ``(samples, sample_rate)`` for the loudness (None: none)."""
+def spoken(speech: SpeechSpec, *, rate: float = 1.0, language: str | None = None,
+           ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+    """The timeline of ``speech`` in its own time (as :func:`speech_timeline`) and its
+    synthesized audio (None for a recording or a viseme script): the slow half of
+    :func:`animate`, which a live session runs once per sentence before it knows when the
+    sentence will start."""
+    speech = check_kind("speech", speech, SpeechSpec)
+    rate = check_number("rate", rate, low=0.25, high=4.0)
+    return _spoken(speech, rate=rate, language=language)
+
+
+def animate_spoken(speech: SpeechSpec, own: SpeechTimeline, audio: SpeechAudio | None, *,
+                   fps: float, max_frames: int = MAX_FRAMES) -> VisemeAnimation:
+    """:func:`animate` of ``speech`` whose timeline ``own`` (in its own ms, from
+    :func:`spoken` or a recognizer) and ``audio`` are known: the curves start at
+    ``speech.start_ms``. ``audio`` (samples at their rate) gives the loudness that drives
+    the jaw; without it a recording named by ``speech.audio`` does."""
+    fps = check_fps(fps)
     timeline = own.shifted(speech.start_ms)
     # through the envelope's release ramp, so the mouth is seen settling back to neutral
     end_ms = speech.start_ms + timeline.duration_ms + timing_rules()["envelope_ramp_ms"]
@@ -208,7 +214,7 @@ def curves(own: SpeechTimeline, speech: SpeechSpec, *, fps: float,
         raise SpeechError(f"speech lasts {end_ms} ms = {n_frames} frames at {fps:g} fps, more "
                           f"than max_frames={max_frames}", path=path, line=line)
     times = frame_times_ms(n_frames, fps)
-    loudness = _frame_loudness(own, sound, times - speech.start_ms)
+    loudness = _frame_loudness(speech, own, audio, times - speech.start_ms)
     env = envelope(timeline.visemes, times)
     gain = jaw_gain(loudness, rules=loudness_rules())
     levels = _levels(speech, timeline)
@@ -230,16 +236,19 @@ def _levels(speech: SpeechSpec, timeline: SpeechTimeline) -> np.ndarray:
         raise SpeechError(f"say: {exc.message}", path=path, line=line) from exc
 
 
-def _frame_loudness(timeline: SpeechTimeline, sound: tuple[np.ndarray, int] | None,
+def _frame_loudness(speech: SpeechSpec, timeline: SpeechTimeline, audio: SpeechAudio | None,
                     times_ms: np.ndarray) -> np.ndarray:
     """``(n_frames,) float32`` dBFS of the speech around each frame (times in the speech's
-    own ms): the RMS level of ``sound`` (samples, rate) over the ``loudness_window_ms``
-    centred on the frame, so the jaw follows the speech envelope within a phone as well as
-    from phone to phone; the floor outside phones and where there is no sound."""
+    own ms): the RMS level over the ``loudness_window_ms`` centred on the frame, so the jaw
+    follows the speech envelope within a phone as well as from phone to phone; the floor
+    outside phones and where there is no audio."""
     out = np.full(times_ms.size, FLOOR_DB, np.float32)
     phones = timeline.phones
-    if phones and sound is not None:
-        samples, sample_rate = sound
+    if phones and (audio is not None or speech.audio is not None):
+        if audio is not None:
+            samples, sample_rate = audio.samples, audio.sample_rate
+        else:
+            samples, sample_rate = load_speech(speech.audio), ALIGN_RATE  # type: ignore[arg-type]
         half = loudness_rules()["window_ms"] / 2
         centre = np.round(times_ms).astype(np.int64)
         levels = window_loudness(samples, sample_rate=sample_rate,

@@ -3,6 +3,7 @@ track, as a storyboard's ``say { audio = ... }`` without text makes it."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ from facelib.checks import check_fps
 from facelib.cues import MAX_FRAMES, SpeechSpec
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.recognize import Method, recognize
-from facelib.visemes.animate import VisemeAnimation, curves
+from facelib.visemes.animate import SpeechAudio, VisemeAnimation, animate_spoken
 from facelib.visemes.articulation import Style
 from facelib.visemes.mapping import with_visemes
 
@@ -52,5 +53,6 @@ def visemes_from_audio(
     phones = recognize(audio, sample_rate=sample_rate, language=language, method=method)
     samples = load_speech(audio, sample_rate=sample_rate)
     spec = SpeechSpec(audio=None, text=None, style=style)
-    return curves(with_visemes(phones), spec, fps=fps, sound=(samples, ALIGN_RATE),
-                  max_frames=max_frames)
+    made = animate_spoken(spec, with_visemes(phones), SpeechAudio(samples, ALIGN_RATE),
+                          fps=fps, max_frames=max_frames)
+    return replace(made, audio=None)  # ``audio`` is synthesized speech; this was recorded
