@@ -2,7 +2,8 @@
 giving frames with their audio.
 
 Frame ``i`` (time ``i / fps``) goes out when the session clock reaches it. Text is spoken
-sentence by sentence as sentences complete (synthesis runs in a worker thread); each
+sentence by sentence as sentences complete (synthesis runs in a worker thread, by an
+espeak-ng process started ahead of the sentence); each
 sentence starts at the first frame not yet out plus the speech envelope's ramp, after the
 speech before it. Streamed audio (16 kHz PCM) starts ``lookahead_ms`` after the first frame
 not yet out, so the recognizer has that much audio past each frame it animates; the audio
@@ -24,11 +25,13 @@ import numpy as np
 
 from facelib.checks import check_number
 from facelib.cues import SpeechSpec
-from facelib.errors import ParameterError
+from facelib.errors import MissingExtraError, ParameterError
 from facelib.live.engine import Engine, Frame
 from facelib.live.inputs import Cues, cues_from_fdl, cues_from_json, split_sentences
 from facelib.live.listen import Listener, pcm16_samples
+from facelib.speech.espeak import Worker
 from facelib.visemes.animate import SpeechAudio, spoken
+from facelib.visemes.timeline import SpeechTimeline
 
 __all__ = ["OUTPUT_RATE", "Output", "Session", "SyncSession"]
 
@@ -140,14 +143,21 @@ class Session:
             await self._sentences.put((sentence, at_ms if k == 0 else None))
 
     async def _speak(self) -> None:
-        """The synthesis worker: sentences in order, each placed when it is ready."""
+        """The synthesis worker: sentences in order, each placed when it is ready. An
+        espeak-ng process waits for the next sentence, started while the session is quiet."""
         while True:
-            sentence, at_ms = await self._sentences.get()
+            spare = await asyncio.to_thread(_spare_worker)
             try:
-                own, audio = await asyncio.to_thread(
-                    spoken, SpeechSpec(text=sentence, lang=self.lang, voice=self.voice,
-                                       rate=self.rate))
-                start = self.engine.add_speech(own, audio, playback=_resampled(audio),
+                sentence, at_ms = await self._sentences.get()
+            except asyncio.CancelledError:
+                if spare is not None:
+                    await asyncio.to_thread(spare.close)
+                raise
+            try:
+                own, audio, playback = await asyncio.to_thread(
+                    _spoken_by, spare, SpeechSpec(text=sentence, lang=self.lang,
+                                                  voice=self.voice, rate=self.rate))
+                start = self.engine.add_speech(own, audio, playback=playback,
                                                text=sentence, at_ms=at_ms)
                 self._event({"type": "speech", "start_ms": start, "text": sentence,
                              "phones": [[p.label, p.start_ms, p.end_ms] for p in own.phones],
@@ -242,6 +252,29 @@ class Session:
         async for item in self.messages():
             if isinstance(item, Output):
                 yield item
+
+
+def _spare_worker() -> Worker | None:
+    """An espeak-ng process started ahead, or None without the ``speech`` extra. The
+    resampler is imported here too (scipy.signal takes most of a second the first time)."""
+    import scipy.signal  # noqa: F401
+
+    try:
+        return Worker()
+    except MissingExtraError:
+        return None
+
+
+def _spoken_by(worker: Worker | None, spec: SpeechSpec,
+               ) -> tuple[SpeechTimeline, SpeechAudio | None, SpeechAudio | None]:
+    """:func:`facelib.visemes.animate.spoken` of ``spec`` by ``worker`` (closed after),
+    and its audio at :data:`OUTPUT_RATE`."""
+    try:
+        own, audio = spoken(spec, worker=worker)
+    finally:
+        if worker is not None:
+            worker.close()
+    return own, audio, _resampled(audio)
 
 
 def _resampled(audio: SpeechAudio | None) -> SpeechAudio | None:
