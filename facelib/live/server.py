@@ -43,7 +43,7 @@ HARD_MESSAGE_BYTES = 1024 * 1024
 """Largest message the WebSocket layer accepts at all (it closes the connection, code 1009)."""
 _OUTPUTS = {"faps", "arkit", "visemes"}
 _START_KEYS = {"type", "token", "fps", "lookahead_ms", "seed", "lang", "voice", "rate",
-               "outputs", "clock", "face"}
+               "outputs", "clock", "face", "audio_in"}
 
 
 @dataclass(frozen=True)
@@ -113,8 +113,10 @@ def _session_from(start: dict[str, Any], options: ServerOptions) -> tuple[Sessio
     outputs = start.get("outputs", ["faps", "visemes"])
     if not isinstance(outputs, list) or not outputs or not set(outputs) <= _OUTPUTS:
         raise ParameterError(f"start: outputs must be a list from {sorted(_OUTPUTS)}")
+    if not isinstance(start.get("audio_in", False), bool):
+        raise ParameterError("start: audio_in must be true or false")
     kwargs = {k: start[k] for k in ("fps", "lookahead_ms", "seed", "lang", "voice", "rate",
-                                    "clock", "face") if k in start}
+                                    "clock", "face", "audio_in") if k in start}
     return Session(arkit="arkit" in outputs, **kwargs), set(outputs)
 
 

@@ -15,6 +15,7 @@ out. With ``clock="manual"`` frames go out only when :meth:`Session.advance` is 
 from __future__ import annotations
 
 import asyncio
+import math
 import threading
 from collections.abc import AsyncIterator, Iterator
 from dataclasses import dataclass, field
@@ -67,14 +68,16 @@ class Session:
     fps: frame rate; lookahead_ms: the audio look-ahead (0-500, default 80); seed: the
     random processes' seed; lang / voice / rate: synthesis of text; arkit: add ARKit-52
     weights to each output (default head only); clock: ``"wall"`` or ``"manual"``;
-    queue_s: seconds of output kept for a slow reader (older frames are dropped).
+    queue_s: seconds of output kept for a slow reader (older frames are dropped);
+    audio_in: the session will be sent audio: the recognizer loads as it starts (about
+    0.6 s in a thread, 90 MB) instead of holding up the first chunk.
     """
 
     def __init__(self, *, face: object | None = None, fps: float = 30.0,
                  lookahead_ms: float = 80.0, seed: int = 0, lang: str = "en",
                  voice: str | None = None, rate: float = 1.0, arkit: bool = False,
                  clock: Literal["wall", "manual"] = "wall", epoch_s: float = 60.0,
-                 queue_s: float = 5.0) -> None:
+                 queue_s: float = 5.0, audio_in: bool = False) -> None:
         if clock not in ("wall", "manual"):
             raise ParameterError(f"clock must be 'wall' or 'manual', got {clock!r}")
         if face is not None:
@@ -92,12 +95,17 @@ class Session:
         self._tasks: list[asyncio.Task[None]] = []
         self._closed = False
         self._t0 = 0.0
+        self._audio_in = bool(audio_in)
+        self._prepared: asyncio.Task[None] | None = None
 
     # -- lifetime ----------------------------------------------------------------------
     async def __aenter__(self) -> Session:
         loop = asyncio.get_running_loop()
         self._t0 = loop.time()
         self._tasks.append(asyncio.create_task(self._speak()))
+        if self._audio_in:
+            self._prepared = asyncio.create_task(asyncio.to_thread(self._listener.prepare))
+            self._tasks.append(self._prepared)
         if self.clock == "wall":
             self._tasks.append(asyncio.create_task(self._tick()))
         return self
@@ -176,14 +184,19 @@ class Session:
             return
         if not np.isfinite(samples).all():
             raise ParameterError("audio samples must be finite")
+        if self._prepared is not None:
+            await self._prepared
         engine = self.engine
         gap = self._audio_next_ms is None or self._audio_next_ms < engine.now_ms
         if gap or self._listener.should_end():
             self._listener.end()
         if self._listener.n_samples == 0:
-            at = engine.now_ms + self.lookahead_ms if gap else self._audio_next_ms
+            # the look-ahead counts from the chunk's arrival (the session clock), not from the
+            # next frame or from when the chunk is decoded
+            now = max(math.ceil(self.now_ms()), engine.now_ms)
+            at = now + self.lookahead_ms if gap else self._audio_next_ms
             timeline, sound = await asyncio.to_thread(self._listener.feed, samples)
-            start = engine.add_speech(timeline, sound, at_ms=at, lead_ms=self.lookahead_ms)
+            start = engine.add_speech(timeline, sound, at_ms=at, lead_ms=0)
         else:
             timeline, sound = await asyncio.to_thread(self._listener.feed, samples)
             start = engine.add_speech(timeline, sound, replace_last=True)
@@ -214,11 +227,12 @@ class Session:
         self._emit(self.engine.advance(until_ms))
 
     async def _tick(self) -> None:
+        """Each frame out when the clock reaches its time (not a frame later)."""
         loop = asyncio.get_running_loop()
         while True:
-            due = self._t0 + self.engine.frame_ms(self.engine.committed + 1) / 1000.0
-            await asyncio.sleep(max(due - loop.time(), 0.0))
-            self._emit(self.engine.advance(self.now_ms()))
+            frame_ms = self.engine.frame_ms(self.engine.committed)
+            await asyncio.sleep(max(self._t0 + frame_ms / 1000.0 - loop.time(), 0.0))
+            self._emit(self.engine.advance(max(self.now_ms(), frame_ms) + 1e-3))
 
     def _emit(self, frames: list[Frame]) -> None:
         arkit = _arkit(frames, self.engine.fps) if self.arkit and frames else None
