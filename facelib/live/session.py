@@ -15,9 +15,11 @@ out. With ``clock="manual"`` frames go out only when :meth:`Session.advance` is 
 from __future__ import annotations
 
 import asyncio
+import functools
 import math
 import threading
 from collections.abc import AsyncIterator, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from math import gcd
 from typing import Any, Literal
@@ -30,6 +32,7 @@ from facelib.errors import MissingExtraError, ParameterError
 from facelib.live.engine import Engine, Frame
 from facelib.live.inputs import Cues, cues_from_fdl, cues_from_json, split_sentences
 from facelib.live.listen import Listener, pcm16_samples
+from facelib.live.plan import Plan, Window, window
 from facelib.speech.espeak import Worker
 from facelib.visemes.animate import SpeechAudio, spoken
 from facelib.visemes.timeline import SpeechTimeline
@@ -38,6 +41,8 @@ __all__ = ["OUTPUT_RATE", "Output", "Session", "SyncSession"]
 
 OUTPUT_RATE = 16000
 """Sample rate of the audio that goes out with the frames (Hz, mono)."""
+_PREFETCH_S = 1.5
+"""A window is computed ahead when the one held has less than this many seconds left."""
 _MAX_TEXT_CHARS = 4000
 _MAX_BUFFER_CHARS = 8000
 
@@ -97,6 +102,9 @@ class Session:
         self._t0 = 0.0
         self._audio_in = bool(audio_in)
         self._prepared: asyncio.Task[None] | None = None
+        self._ahead: tuple[Plan, asyncio.Future[Window]] | None = None  # window computing
+        # a thread of its own for windows: not queued behind synthesis in the loop's pool
+        self._windows = ThreadPoolExecutor(max_workers=1, thread_name_prefix="facelib-live")
 
     # -- lifetime ----------------------------------------------------------------------
     async def __aenter__(self) -> Session:
@@ -118,9 +126,12 @@ class Session:
         if self._closed:
             return
         self._closed = True
+        if self._ahead is not None:
+            self._ahead[1].cancel()
         for task in self._tasks:
             task.cancel()
         await asyncio.gather(*self._tasks, return_exceptions=True)
+        self._windows.shutdown(wait=False, cancel_futures=True)
         self._put(None)
 
     async def stop(self) -> None:
@@ -232,7 +243,32 @@ class Session:
         while True:
             frame_ms = self.engine.frame_ms(self.engine.committed)
             await asyncio.sleep(max(self._t0 + frame_ms / 1000.0 - loop.time(), 0.0))
-            self._emit(self.engine.advance(max(self.now_ms(), frame_ms) + 1e-3))
+            until = max(self.now_ms(), frame_ms) + 1e-3
+            await self._window_for(until)
+            self._emit(self.engine.advance(until))
+
+    async def _window_for(self, until_ms: float) -> None:
+        """Compute the engine's next window in a worker thread, ahead of need (the event
+        loop, and every other session on it, goes on meanwhile); wait for it only when
+        the frames before ``until_ms`` need it."""
+        engine = self.engine
+        wanted = engine.wanted(margin_s=_PREFETCH_S)
+        ahead = self._ahead
+        if wanted is not None and (ahead is None or ahead[0] is not wanted[0]):
+            plan, n = wanted
+            task = asyncio.ensure_future(asyncio.get_running_loop().run_in_executor(
+                self._windows, functools.partial(window, plan, n_frames=n, rules=engine.rules)))
+            ahead = self._ahead = (plan, task)
+        if ahead is None:
+            return
+        if not ahead[1].done() and not engine.covers(until_ms):
+            await asyncio.wait([ahead[1]])
+        if ahead[1].done():
+            self._ahead = None
+            task = ahead[1]
+            if not task.cancelled() and task.exception() is None:  # else the engine
+                # computes it itself (and raises)
+                engine.offer(ahead[0], task.result())
 
     def _emit(self, frames: list[Frame]) -> None:
         arkit = _arkit(frames, self.engine.fps) if self.arkit and frames else None
