@@ -20,6 +20,9 @@ import numpy as np
 
 from facelib.live.session import Session
 
+_SPEECH_FAPS = np.array([3, 4, 5, 8, 9, 10, 11]) - 1
+"""Jaw and mid-lip FAPs: the visemes drive them, idle motion does not (the lip corners,
+FAPs 6, 7, 12, 13, move with the idle face and are left out)."""
 SENTENCES = ["Hello there.", "How are you today?", "The weather is fine.",
              "Let us begin the lesson.", "Thank you very much."]
 
@@ -43,7 +46,7 @@ async def text_latency(n: int) -> tuple[list[float], list[float], float]:
                 out = await frames.__anext__()
                 if out.frame.index < first:
                     continue
-                if got_mouth is None and np.abs(out.frame.faps[2:18]).max() > 1:
+                if got_mouth is None and np.abs(out.frame.faps[_SPEECH_FAPS]).max() > 1:
                     got_mouth = time.perf_counter() - t0
                 if np.abs(out.audio).max() > 0.02:
                     voiced.append(time.perf_counter() - t0)
