@@ -33,6 +33,7 @@ from facelib.live.engine import Engine, Frame
 from facelib.live.inputs import Cues, cues_from_fdl, cues_from_json, split_sentences
 from facelib.live.listen import Listener, pcm16_samples
 from facelib.live.plan import Plan, Window, window
+from facelib.live.udp import UdpTarget, parse_target
 from facelib.speech.espeak import Worker
 from facelib.visemes.animate import SpeechAudio, spoken
 from facelib.visemes.timeline import SpeechTimeline
@@ -51,13 +52,15 @@ _MAX_BUFFER_CHARS = 8000
 class Output:
     """A frame with what goes out with it: ``audio`` ``(k,) float32`` at
     :data:`OUTPUT_RATE` from the frame's time to the next frame's, ``arkit`` ``(52,)
-    float32`` weights when asked for (None otherwise), and ``dropped``, the frames dropped
-    before this one because the reader was slow."""
+    float32`` weights and ``angles`` ``(9,) float32`` radians (head and eyes,
+    :data:`facelib.export.arkit.ANGLE_NAMES`) when asked for (None otherwise), and
+    ``dropped``, the frames dropped before this one because the reader was slow."""
 
     frame: Frame
     audio: np.ndarray
     arkit: np.ndarray | None = None
     dropped: int = 0
+    angles: np.ndarray | None = None
 
 
 @dataclass
@@ -75,14 +78,18 @@ class Session:
     weights to each output (default head only); clock: ``"wall"`` or ``"manual"``;
     queue_s: seconds of output kept for a slow reader (older frames are dropped);
     audio_in: the session will be sent audio: the recognizer loads as it starts (about
-    0.6 s in a thread, 90 MB) instead of holding up the first chunk.
+    0.6 s in a thread, 90 MB) instead of holding up the first chunk; livelink / vmc:
+    ``"HOST:PORT"`` to send each frame to as a Live Link Face packet
+    (:mod:`facelib.live.livelink`, port 11111 if left out) or a VMC bundle
+    (:mod:`facelib.live.vmc`, port 39539); subject: the Live Link subject name.
     """
 
     def __init__(self, *, face: object | None = None, fps: float = 30.0,
                  lookahead_ms: float = 80.0, seed: int = 0, lang: str = "en",
                  voice: str | None = None, rate: float = 1.0, arkit: bool = False,
                  clock: Literal["wall", "manual"] = "wall", epoch_s: float = 60.0,
-                 queue_s: float = 5.0, audio_in: bool = False) -> None:
+                 queue_s: float = 5.0, audio_in: bool = False, livelink: str | None = None,
+                 vmc: str | None = None, subject: str = "facelib") -> None:
         if clock not in ("wall", "manual"):
             raise ParameterError(f"clock must be 'wall' or 'manual', got {clock!r}")
         if face is not None:
@@ -92,6 +99,8 @@ class Session:
         self.lang, self.voice = lang, voice
         self.rate = check_number("rate", rate, low=0.5, high=2.5)
         self.arkit, self.clock = bool(arkit), clock
+        self.udp = _targets(livelink, vmc)
+        self.subject = subject
         self._text = ""
         self._listener = Listener()
         self._audio_next_ms: int | None = None  # session ms where the next audio sample goes
@@ -132,6 +141,8 @@ class Session:
             task.cancel()
         await asyncio.gather(*self._tasks, return_exceptions=True)
         self._windows.shutdown(wait=False, cancel_futures=True)
+        for target in self.udp.values():
+            target.close()
         self._put(None)
 
     async def stop(self) -> None:
@@ -271,12 +282,30 @@ class Session:
                 engine.offer(ahead[0], task.result())
 
     def _emit(self, frames: list[Frame]) -> None:
-        arkit = _arkit(frames, self.engine.fps) if self.arkit and frames else None
+        weights = angles = None
+        if (self.arkit or self.udp) and frames:
+            weights, angles = _arkit(frames, self.engine.fps)
+            self._send_udp(frames, weights, angles)
+        if not self.arkit:
+            weights = angles = None
         for k, frame in enumerate(frames):
             audio = self.engine.audio(frame.time_ms, self.engine.frame_ms(frame.index + 1),
                                       sample_rate=OUTPUT_RATE)
-            self._put(Output(frame, audio, None if arkit is None else arkit[k],
-                             self._queue.dropped))
+            self._put(Output(frame, audio, None if weights is None else weights[k],
+                             self._queue.dropped, None if angles is None else angles[k]))
+
+    def _send_udp(self, frames: list[Frame], weights: np.ndarray, angles: np.ndarray) -> None:
+        """Each frame to the Live Link and VMC targets, as it goes out."""
+        from facelib.live import livelink, vmc
+
+        for k, frame in enumerate(frames):
+            if "livelink" in self.udp:
+                self.udp["livelink"].send(livelink.packet(
+                    weights[k], angles[k], frame=frame.index, fps=self.engine.fps,
+                    subject=self.subject))
+            if "vmc" in self.udp:
+                self.udp["vmc"].send(vmc.bundle(weights[k], angles[k], viseme=frame.viseme,
+                                                time_s=frame.time_ms / 1000))
 
     def _event(self, message: dict[str, Any]) -> None:
         self._put(message)
@@ -338,13 +367,29 @@ def _resampled(audio: SpeechAudio | None) -> SpeechAudio | None:
     return SpeechAudio(np.clip(samples, -1, 1).astype(np.float32), OUTPUT_RATE)
 
 
-def _arkit(frames: list[Frame], fps: float) -> np.ndarray:
-    """``(len(frames), 52) float32`` ARKit weights of the frames on the default head."""
+def _targets(livelink: str | None, vmc: str | None) -> dict[str, UdpTarget]:
+    """The UDP senders a session was asked for, by kind."""
+    from facelib.live import livelink as ll
+    from facelib.live import vmc as vm
+
+    out = {}
+    if livelink is not None:
+        out["livelink"] = UdpTarget(*parse_target(livelink, default_port=ll.DEFAULT_PORT))
+    if vmc is not None:
+        vm._osc()  # MissingExtraError now, not at the first frame
+        out["vmc"] = UdpTarget(*parse_target(vmc, default_port=vm.DEFAULT_PORT))
+    return out
+
+
+def _arkit(frames: list[Frame], fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(len(frames), 52) float32`` ARKit weights of the frames on the default head and
+    ``(len(frames), 9) float32`` head and eye angles (radians)."""
     from facelib.export.arkit import to_arkit
     from facelib.mpeg4.stream import FapStream
 
     stream = FapStream(fps, np.stack([f.faps for f in frames]), np.stack([f.mask for f in frames]))
-    return to_arkit(stream).weights
+    curves = to_arkit(stream)
+    return curves.weights, curves.angles
 
 
 class SyncSession:
