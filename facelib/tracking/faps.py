@@ -404,13 +404,11 @@ def measure_faps(
     layout: a packaged layout name (``"mediapipe"``, ``"ibug68"``) or a
         :class:`~facelib.tracking.layouts.LandmarkLayout`.
     neutral: the neutral frame, or a ``(start, stop)`` span averaged over its frames with a
-        face; None: the first frame with a face, unless it is clearly not neutral: then
-        the most neutral span found (:mod:`~facelib.tracking.neutral`, with a
-        TrackingWarning). TrackingError when it has none.
+        face; None: the first frame with a face, or :func:`find_neutral`'s span (warned)
+        when that is clearly not neutral. TrackingError when it has none.
     fapu: FAPU overrides in the landmarks' unit (e.g. ``{"MNS": 18.3 / 1024}``).
-    smooth: apply the One Euro filter (both ways) and, with the mouth state, draw open_jaw
-        across brief closures (:func:`~facelib.tracking.lipclosure.bridge_jaw`): the
-        temporal steps that need the whole track.
+    smooth: the steps that need the whole track: the One Euro filter (both ways) and, with
+        the mouth state, open_jaw drawn across brief closures (``lipclosure.bridge_jaw``).
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
     relations: fill untracked FAPs by eq. 4.17.
     rig: the model read off the landmark motion instead of eq. 4.16's one point per FAP:
