@@ -88,10 +88,11 @@ def animate(
 ) -> FapTrack:
     """The expression track of a storyboard.
 
-    Each cue contributes ``envelope * intensity * expression`` to the FAPs its expression
-    drives. Where cues overlap, the values are averaged with their envelopes as weights
-    once the envelopes add up to more than 1, so two full expressions blend half and half
-    and a fading one hands over smoothly. Between cues the face is neutral.
+    Each cue contributes ``envelope * share(intensity) * expression`` to the FAPs its
+    expression drives (``share``: the expression's intensity curve, ``intensity.csv``).
+    Where cues overlap, the values are averaged with their envelopes as weights once the
+    envelopes add up to more than 1, so two full expressions blend half and half and a
+    fading one hands over smoothly. Between cues the face is neutral.
 
     The track's weight on a FAP is the summed envelope (at most 1) times the expression's
     ``importance`` (name -> [0, 1], default 1), which the synchronizer uses to blend the
@@ -119,7 +120,7 @@ def animate(
                      int(np.searchsorted(times, cue.end_ms, side="right")))
         e = envelope(times[span], start_ms=cue.start_ms, duration_ms=cue.duration_ms,
                      ramp_in_ms=ramp_in, ramp_out_ms=ramp_out, easing=easing)[:, None]
-        total[span] += e * cue.intensity * expression.values
+        total[span] += e * expression.share(cue.intensity) * expression.values
         strength[span] += e * expression.mask
         weight[span] += e * expression.mask * float(importance.get(expression.name, 1.0))
     values = total / np.maximum(strength, 1.0)
