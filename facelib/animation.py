@@ -129,20 +129,16 @@ def _animate(
         viseme_track = _with_importance(speech, rules).padded(n_frames)
         speaking[: speech.speaking.size] = speech.speaking[:n_frames]
     step(1)
-    expression_track = expressions.animate(
-        storyboard.expressions, fps=fps, n_frames=n_frames,
-        library=expressions.default_library().with_defs(
-            storyboard.expression_defs, mixes=storyboard.expression_mixes
-        ),
-        importance=rules.expression_importance,
-    )
+    expression_track, moods = _expression_track(storyboard, n_frames, rules)
     step(2)
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
                         behaviours=storyboard.gaze_defs, speaking=speaking)
     step(3)
     stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
                      blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=speaking,
-                     rules=rules, seed=storyboard.seed)
+                     rules=rules, seed=storyboard.seed,
+                     head_scale=None if moods is None else moods.scales["head_motion_scale"],
+                     speech_brow=None if moods is None else moods.scales["speech_brow"])
     step(4)
     return Animation(
         faps=stream,
@@ -155,6 +151,20 @@ def _animate(
         speech_audio=None if speech is None else speech.audio,
         loudness=None if speech is None else speech.loudness,
     )
+
+
+def _expression_track(storyboard: Storyboard, n_frames: int,
+                      rules: SyncRules) -> tuple[FapTrack, expressions.MoodCurves | None]:
+    """The expression track with the storyboard's moods blended under it, and the moods."""
+    fps = storyboard.fps
+    library = expressions.default_library().with_defs(
+        storyboard.expression_defs, mixes=storyboard.expression_mixes)
+    moods = (expressions.mood_curves(storyboard.moods, fps=fps, n_frames=n_frames,
+                                     library=library) if storyboard.moods else None)
+    track = expressions.animate(storyboard.expressions, fps=fps, n_frames=n_frames,
+                                library=library, importance=rules.expression_importance,
+                                moods=moods)
+    return track, moods
 
 
 def _with_importance(speech: VisemeAnimation, rules: SyncRules) -> FapTrack:

@@ -10,8 +10,9 @@ FAP 2 (expression) selects two of the six standard expressions (1 joy, 2 sadness
     expression = intensity1 / 63 * E[select1] + intensity2 / 63 * E[select2]
 
 ``V`` and ``E`` are the FAP values of facelib's viseme table
-(``facelib/data/visemes/viseme_faps.json``) and expression library
-(composed from its action units, :mod:`facelib.mpeg4.action_units`) at full intensity. The viseme and the expression add up;
+(``facelib/data/visemes/viseme_faps.json``) and expression library (composed from its
+action units, :mod:`facelib.mpeg4.action_units`) at full intensity. The viseme and the
+expression add up;
 a low-level FAP that the frame sets itself keeps its own value (the file's author animated
 it explicitly), every other FAP takes the decoded value.
 """
