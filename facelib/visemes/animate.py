@@ -18,6 +18,7 @@ from facelib.speech import timeline_from_text as phones_from_text
 from facelib.speech.align import OnImplausible
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.dtw import align_dtw as align_phones_dtw
+from facelib.speech.espeak import Worker
 from facelib.speech.loudness import FLOOR_DB, window_loudness
 from facelib.speech.recognize import recognize
 from facelib.speech.synth import DEFAULT_LANGUAGE
@@ -116,7 +117,7 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0,
 
 
 def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
-            ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+            worker: Worker | None = None) -> tuple[SpeechTimeline, SpeechAudio | None]:
     lang = speech.lang or language or DEFAULT_LANGUAGE
     if speech.visemes:
         spans = visemes_from_cues(speech.visemes)
@@ -138,7 +139,8 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
                               f"{MAX_SPEECH_TEXT_CHARS}", path=path, line=line)
         try:
             made = synthesize_speech(speech.text, lang=lang, voice=speech.voice,
-                              rate=min(max(speech.rate * rate, 0.5), 2.5), pitch=speech.pitch)
+                                     rate=min(max(speech.rate * rate, 0.5), 2.5),
+                                     pitch=speech.pitch, worker=worker)
         except MissingExtraError:
             if not lang.lower().startswith("en"):
                 raise
@@ -188,14 +190,15 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
 
 
 def spoken(speech: SpeechSpec, *, rate: float = 1.0, language: str | None = None,
-           ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+           worker: Worker | None = None) -> tuple[SpeechTimeline, SpeechAudio | None]:
     """The timeline of ``speech`` in its own time (as :func:`speech_timeline`) and its
     synthesized audio (None for a recording or a viseme script): the slow half of
     :func:`animate`, which a live session runs once per sentence before it knows when the
-    sentence will start."""
+    sentence will start. ``worker``: an espeak-ng process started ahead for text (the same
+    result, sooner; :class:`facelib.speech.espeak.Worker`)."""
     speech = check_kind("speech", speech, SpeechSpec)
     rate = check_number("rate", rate, low=0.25, high=4.0)
-    return _spoken(speech, rate=rate, language=language)
+    return _spoken(speech, rate=rate, language=language, worker=worker)
 
 
 def animate_spoken(speech: SpeechSpec, own: SpeechTimeline, audio: SpeechAudio | None, *,
