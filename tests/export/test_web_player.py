@@ -38,7 +38,7 @@ def shots(tmp_path_factory):
     from facelib.rendering.scene import FaceRenderer
 
     root = tmp_path_factory.mktemp("web")
-    stream = busy_stream(50)
+    stream = busy_stream(250)  # 10 s: playing must not reach the end between slow shots
     audio = Path(__file__).parents[2] / "examples" / "hello" / "hello.flac"
     export_html(stream, root / "page", audio=audio)
     face = default_face()
