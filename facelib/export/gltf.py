@@ -28,7 +28,7 @@ from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
 
-__all__ = ["GltfExport", "export_gltf"]
+__all__ = ["GltfExport", "export_gltf", "primitive_vertex_ids"]
 
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
 _ARRAY, _ELEMENTS = 34962, 34963
@@ -181,6 +181,13 @@ def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return out.astype(np.float32)
 
 
+def primitive_vertex_ids(part: Any) -> np.ndarray:
+    """(K,) int64 sorted: the face vertices a part's primitive holds, its own and those its
+    triangles use (a part such as the bust takes the triangles that join it to the skin, whose
+    seam vertices belong to the skin)."""
+    return np.union1d(part.vertex_ids.astype(np.int64), part.triangles.reshape(-1))
+
+
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
     """One primitive per part; ``targets`` (T, V, 3) float32 displacements."""
     lib = b.lib
@@ -197,7 +204,7 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     weights[:, :2] = rig.weights
     out = []
     for name, part in face.parts.items():
-        ids = np.sort(part.vertex_ids.astype(np.int64))
+        ids = primitive_vertex_ids(part)
         local = np.full(face.n_vertices, -1, np.int64)
         local[ids] = np.arange(len(ids))
         tris = local[part.triangles].astype(np.uint16 if len(ids) < 65536 else np.uint32)
