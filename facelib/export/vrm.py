@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from facelib import __version__, data
+from facelib import data
 from facelib.atomic import atomic_path
 from facelib.engine import Face, default_face
 from facelib.errors import ParameterError
@@ -115,7 +115,7 @@ def _vrm_extension(face: Face, rig: Rig, nodes: dict[str, int], joint_nodes: lis
 
 
 def _meta(overrides: dict[str, Any] | None) -> dict[str, Any]:
-    meta = {"version": __version__, **data.json_data(_FILE)["meta"], **(overrides or {})}
+    meta = {**data.json_data(_FILE)["meta"], **(overrides or {})}
     authors = meta.get("authors")
     if not meta.get("name") or not isinstance(authors, list | tuple) or not any(authors):
         raise ParameterError("VRM meta needs a name and at least one non-empty author")
@@ -160,7 +160,7 @@ def _container(lib: Any, face: Face, names: tuple[str, ...], meta: dict[str, Any
     """The ``.vrm`` bytes: the mesh with one target per preset, the skin at rest, the body
     nodes and the extension."""
     rig = build_rig(face)
-    g = lib.GLTF2(asset=lib.Asset(generator=f"facelib {__version__}", version="2.0"))
+    g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
     b = _Builder(g, lib)
     mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, preset_targets(face)),
                     weights=[0.0] * len(names))
