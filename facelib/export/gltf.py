@@ -18,7 +18,7 @@ import numpy as np
 
 from facelib import data
 from facelib.atomic import atomic_path
-from facelib.engine import Face, default_face, surface
+from facelib.engine import Face, Part, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import MissingExtraError, ParameterError
 from facelib.export.audio import copy_audio
@@ -181,11 +181,15 @@ def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return out.astype(np.float32)
 
 
-def primitive_vertex_ids(part: Any) -> np.ndarray:
-    """(K,) int64 sorted: the face vertices a part's primitive holds, its own and those its
-    triangles use (a part such as the bust takes the triangles that join it to the skin, whose
-    seam vertices belong to the skin)."""
-    return np.union1d(part.vertex_ids.astype(np.int64), part.triangles.reshape(-1))
+def primitive_vertex_ids(part: Part) -> np.ndarray:
+    """The face vertex each vertex of ``part``'s primitive is, ``(Vq,) int64``: the part's
+    own vertices (sorted), then those of other parts that its triangles use (sorted; the
+    bust's first triangles use the head's neck loop). A primitive's indices can only name
+    its own vertices, so those are copied into it with all their attributes and targets,
+    and the copies move as the originals do."""
+    own = np.sort(part.vertex_ids.astype(np.int64))
+    used = np.unique(part.triangles.astype(np.int64))
+    return np.concatenate([own, np.setdiff1d(used, own, assume_unique=True)])
 
 
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:

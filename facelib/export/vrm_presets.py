@@ -2,10 +2,10 @@
 (``facelib/data/export/vrm.json``) and the face deformed by it.
 
 A recipe is one FAP frame (84 values, FAP units): a viseme's FAPs at full intensity
-(``visemes/viseme_faps.json``), an expression's (``expressions.csv``), FAPs given in the file
+(``visemes/viseme_faps.json``), a library expression's (its action units composed by
+:mod:`facelib.mpeg4.action_units`, as the expression library does), FAPs given in the file
 (the blinks) or an eye turn in degrees (the looks). The export layer may not import the
-viseme and expression packages, so their two data files are read here through
-:mod:`facelib.data`, the same files those packages read.
+viseme package, so its data file is read here through :mod:`facelib.data`.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import numpy as np
 from facelib import data
 from facelib.engine import Face
 from facelib.errors import DataError, ParameterError
+from facelib.mpeg4.action_units import compose, recipes
 from facelib.mpeg4.tables import N_FAPS, fap
 
 __all__ = ["preset_names", "preset_recipes", "preset_targets"]
@@ -28,11 +29,12 @@ def preset_names() -> tuple[str, ...]:
 
 
 def _expression_faps(name: str) -> dict[str, float]:
-    rows = [row for _, row in data.csv_rows("expressions.csv") if row["expression"] == name]
-    if not rows:
-        raise DataError(f"{_FILE}: no expression {name!r} in expressions.csv",
+    library = recipes()
+    if name not in library:
+        raise DataError(f"{_FILE}: no expression {name!r} in expressions/expressions.csv",
                         path=str(data.path(_FILE)))
-    return {row["fap"]: float(row["value"]) for row in rows}
+    values, mask = compose(library[name].parts)
+    return {fap(int(k) + 1).name: float(values[k]) for k in np.flatnonzero(mask)}
 
 
 def _viseme_faps(name: str) -> dict[str, float]:

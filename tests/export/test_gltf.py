@@ -43,6 +43,29 @@ def test_evaluated_gltf_matches_deform_within_a_tenth_of_a_millimetre(exported):
     assert np.abs(want[6] - face.vertices).max() > 0.01
 
 
+def test_each_primitive_indexes_its_own_vertices_the_bust_copies_the_neck_loop(exported):
+    """A primitive's indices name only its own vertices: the bust's triangles that join it to
+    the head's neck loop get copies of those skin vertices (same place, same normal), so
+    the seam stays closed and shaded alike."""
+    result, _ = exported
+    face = default_face()
+    gltf = Gltf(result.path)
+    prims = dict(zip(face.parts, gltf.g.meshes[0].primitives, strict=True))
+    for name, prim in prims.items():
+        positions = gltf.accessor(prim.attributes.POSITION)
+        tris = gltf.accessor(prim.indices).reshape(-1, 3)
+        ids = primitive_vertex_ids(face.parts[name])
+        assert tris.max() < len(positions) == len(ids), name
+        assert len(tris) == len(face.parts[name].triangles), name
+        np.testing.assert_allclose(positions, face.vertices[ids], atol=1e-6)
+    bust = face.parts["bust"]
+    borrowed = primitive_vertex_ids(bust)[bust.vertex_ids.size:]
+    assert len(borrowed) > 20 and np.isin(borrowed, face.parts["skin"].vertex_ids).all()
+    normals = [gltf.accessor(prims[n].attributes.NORMAL) for n in ("skin", "bust")]
+    at_skin = np.searchsorted(np.sort(face.parts["skin"].vertex_ids), borrowed)
+    np.testing.assert_allclose(normals[1][bust.vertex_ids.size:], normals[0][at_skin])
+
+
 def test_vertex_colours_carry_the_baked_occlusion(exported):
     """COLOR_0 is the linear colour darkened by the ambient occlusion as the renderer does
     it: deep in the mouth far darker than the colour alone, the open cheek unchanged."""
