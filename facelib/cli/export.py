@@ -1,4 +1,5 @@
-"""``facelib export SOURCE``: glTF (.glb), ARKit curves (.csv/.json) or a web page."""
+"""``facelib export SOURCE``: glTF (.glb), ARKit curves (.csv/.json), a VRM avatar (.vrm) or a
+web page."""
 
 from __future__ import annotations
 
@@ -24,6 +25,9 @@ def add(commands: Any) -> None:
                         help="glTF morph targets: one per FAP basis vector (fap, the default) or "
                              "the 52 ARKit-named shapes of the head (arkit)")
     export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
+    export.add_argument("--vrm", metavar="OUT.vrm",
+                        help="also write a VRM 1.0 avatar of the head (expression presets aa ... "
+                             "lookRight, humanoid, look-at; no animation)")
     export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
     export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
     export.add_argument("--seed", type=int)
@@ -34,9 +38,11 @@ def _export(args: argparse.Namespace, console: Console) -> int:
 
     from facelib import export
 
-    if args.output is None and args.html is None:
+    if args.output is None and args.html is None and args.vrm is None:
         raise UsageError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
-                         "or both")
+                         "--vrm OUT.vrm, or several")
+    if args.vrm is not None:
+        check_suffix(args.vrm, (".vrm",), "export --vrm")
     if args.output is not None:
         check_suffix(args.output, (".csv", ".json") if args.arkit else
                      (".glb", ".csv", ".json"), "export")
@@ -57,6 +63,10 @@ def _export(args: argparse.Namespace, console: Console) -> int:
             audio = f", audio {result.audio}" if result.audio else ""
             console.status(f"wrote {result.path} ({len(result.names)} morph targets, "
                            f"{result.n_frames} frames{audio})")
+    if args.vrm is not None:
+        avatar = export.export_vrm(source, args.vrm, face=face)
+        console.status(f"wrote {avatar.path} (VRM 1.0: {len(avatar.presets)} expression "
+                       f"presets, {len(avatar.bones)} humanoid bones)")
     if args.html is not None:
         page = export.export_html(source, args.html, face=face, audio=args.audio)
         console.status(f"wrote {page.page} (open it in a browser)")

@@ -33,3 +33,12 @@ def test_export_glb_html_and_arkit_then_import(tmp_path, capsys):
 def test_export_needs_an_output(capsys):
     assert main(["export", str(FAP)]) == 2  # a usage error
     assert "give -o" in capsys.readouterr().err
+
+
+def test_export_vrm_writes_an_avatar_and_checks_the_suffix(tmp_path, capsys):
+    out = tmp_path / "head.vrm"
+    assert main(["export", str(FAP), "--vrm", str(out)]) == 0
+    assert "17 expression presets" in capsys.readouterr().err
+    assert out.read_bytes()[:4] == b"glTF" and b'"VRMC_vrm"' in out.read_bytes()[:200_000]
+    assert main(["export", str(FAP), "--vrm", str(tmp_path / "head.glb")]) == 2
+    assert "writes .vrm" in capsys.readouterr().err
