@@ -38,6 +38,7 @@ from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import FaceModelError, ParameterError, RenderError
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
+from facelib.rendering.readback import install_colour_readback
 
 __all__ = [
     "ANTIALIAS",
@@ -161,11 +162,13 @@ class PartMesh:
     vertex_ids: ``(Vp,) int64`` global vertex ids used by this piece, sorted.
     triangles: ``(Fp, 3) uint32`` indices into ``vertex_ids``, wound counter-clockwise seen
         from outside.
+    double_sided: whether both faces are drawn; None: as the part's material says.
     """
 
     name: str
     vertex_ids: np.ndarray
     triangles: np.ndarray
+    double_sided: bool | None = None
 
 
 def _orient_outward(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -325,6 +328,43 @@ def _occlusion_factor(n: int, occlusion: Any, strength: np.ndarray | float,
     return occlusion_factor(occlusion, strength=strength, power=power)
 
 
+def _sub_piece(piece: PartMesh, local: np.ndarray, *, double_sided: bool) -> PartMesh:
+    """The part of ``piece`` that triangles ``local`` ``(F, 3)`` (indices into its
+    ``vertex_ids``) use, re-indexed to its own vertices."""
+    used = np.unique(local)
+    return PartMesh(piece.name, piece.vertex_ids[used],
+                    np.searchsorted(used, local).astype(np.uint32), double_sided)
+
+
+def _cull_hidden_sides(pieces: list[PartMesh], vertices: np.ndarray, triangles: np.ndarray,
+                       face: Any, look: Look) -> list[PartMesh]:
+    """``pieces`` with each part whose material sets ``single_sided_within_es`` cut by
+    :func:`facelib.rendering.hair.split_hair` into a single-sided piece (the triangles
+    within that many eye separations of the other parts) and a double-sided rest. A face
+    without FAPU (``face.fapu["ES"]``) keeps its pieces."""
+    from facelib.rendering.hair import split_hair
+
+    es = (getattr(face, "fapu", None) or {}).get("ES")
+    wanted = [p for p in pieces if look.material(p.name).get("single_sided_within_es")]
+    if es is None or not wanted:
+        return pieces
+    normals = vertex_normals(vertices, triangles)
+    out: list[PartMesh] = []
+    for piece in pieces:
+        within = float(look.material(piece.name).get("single_sided_within_es", 0.0))
+        if piece not in wanted:
+            out.append(piece)
+            continue
+        others = np.ones(len(vertices), bool)
+        others[piece.vertex_ids] = False
+        single, double = split_hair(vertices[piece.vertex_ids], piece.triangles,
+                                    vertices[others], normals[others],
+                                    within=within * 1024.0 * float(es))
+        out += [_sub_piece(piece, tris, double_sided=sides)
+                for tris, sides in ((single, False), (double, True)) if len(tris)]
+    return out
+
+
 def _piece_uv(pieces: Sequence[PartMesh], hair_uv: Any) -> list[np.ndarray | None]:
     """Per piece, the hair card coordinates ``(Vp, 2) float32`` of the ``hair`` piece (the
     face shader draws strands with them) and None for every other piece."""
@@ -480,7 +520,9 @@ class FaceRenderer:
         self.n_vertices = len(vertices)
         self._triangles = triangles
         self._normal_op = normal_operator(self.n_vertices, triangles)
-        self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
+        self._pieces = _cull_hidden_sides(
+            split_parts(vertices, triangles, getattr(face, "parts", None)), vertices,
+            triangles, face, self.look)
         strength, power = _part_occlusion(self.look, self._pieces, len(vertices))
         # the occlusion darkens the albedo, and rides in the colour's alpha for the face
         # shader to dim the highlights too (no gloss deep in the mouth); pyrender blends
@@ -490,7 +532,7 @@ class FaceRenderer:
         linear = srgb_to_linear(colors) * factor[:, None]
         self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
                         for p in self._pieces]
-        self._materials = [self._material(p.name) for p in self._pieces]
+        self._materials = [self._material(p) for p in self._pieces]
         self._uv = _piece_uv(self._pieces, getattr(face, "hair_uv", None))
         # pyrender interleaves position, normal, texcoord_0 (hair only) and colour
         self._interleaved = [np.empty((len(c), 10 if uv is None else 12), np.float32)
@@ -522,6 +564,7 @@ class FaceRenderer:
                 f"OpenGL context ({type(exc).__name__}: {exc}); {INSTALL_HINT}"
             ) from exc
         install_program_cache(self._pr, renderer._renderer, self.look)
+        install_colour_readback(renderer)
         return renderer
 
     def _open(self, antialias: str) -> None:
@@ -547,13 +590,14 @@ class FaceRenderer:
 
     # -- scene construction -----------------------------------------------------------
 
-    def _material(self, part: str) -> Any:
-        spec = self.look.material(part)
+    def _material(self, piece: PartMesh) -> Any:
+        spec = self.look.material(piece.name)
+        sides = piece.double_sided
         return self._pr.MetallicRoughnessMaterial(
             baseColorFactor=(1.0, 1.0, 1.0, 1.0),
             metallicFactor=float(spec.get("metallic", 0.0)),
             roughnessFactor=float(spec.get("roughness", 0.6)),
-            doubleSided=bool(spec.get("double_sided", False)),
+            doubleSided=bool(spec.get("double_sided", False)) if sides is None else sides,
         )
 
     def _build_scene(
