@@ -119,9 +119,10 @@ class _Child:
         camera = renderer.scene.main_camera_node.camera
         mvp = camera.get_projection_matrix(renderer.width, renderer.height) @ np.linalg.inv(
             renderer.camera_pose)
+        command = [sys.executable, str(here / "render_ceiling.py"), label, args.size,
+                   str(samples), str(args.frames), ",".join(repr(float(v)) for v in mvp.ravel())]
         self.process = subprocess.Popen(
-            [sys.executable, str(here / "render_ceiling.py"), label, args.size, str(samples),
-             str(args.frames), ",".join(repr(float(v)) for v in mvp.ravel())], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
             env={**os.environ, "PYTHONPATH": os.pathsep.join(
                 [str(here), os.environ.get("PYTHONPATH", "")])})
         self.mode = self._answer()
