@@ -22,7 +22,7 @@ from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.progress import ProgressCallback, progress_callback
-from facelib.sync import SyncRules, combine
+from facelib.sync import Liveliness, SyncRules, combine
 from facelib.visemes.animate import SpeechAudio, VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
 
@@ -77,6 +77,7 @@ def animate(
     storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
     max_frames: int = MAX_FRAMES,
     progress: bool | ProgressCallback | None = None,
+    liveliness: Liveliness | None = None,
 ) -> Animation:
     """Run the generators of a storyboard and resolve their conflicts.
 
@@ -87,12 +88,15 @@ def animate(
     :data:`facelib.cues.MAX_FRAMES`); a longer storyboard raises ParameterError before
     anything is computed. ``progress`` (see :mod:`facelib.progress`) is called after each
     of the four stages (speech, expressions, gaze, synchronizer) as ``progress(done, 4)``.
+    ``liveliness`` scales breathing, listening motion, micro-movements and the blink rate
+    (:class:`facelib.sync.Liveliness`; default: the data's numbers).
     An error of a generator that names no file is raised again naming the storyboard (and
     the line of the definition it concerns, where one can be found).
     """
     try:
         return _animate(storyboard, seed=seed, rules=rules, max_frames=max_frames,
-                        report=progress_callback(progress, "animating", unit="stages"))
+                        report=progress_callback(progress, "animating", unit="stages"),
+                        liveliness=liveliness)
     except FacelibError as exc:
         if exc.path is not None or storyboard.path is None:
             raise
@@ -102,7 +106,7 @@ def animate(
 
 def _animate(
     storyboard: Storyboard, *, seed: int | None, rules: SyncRules | None, max_frames: int,
-    report: ProgressCallback | None,
+    report: ProgressCallback | None, liveliness: Liveliness | None,
 ) -> Animation:
     def step(done: int) -> None:
         if report is not None:
@@ -129,7 +133,7 @@ def _animate(
     stream, tracks, eyes = compose(
         storyboard, visemes=viseme_track,
         speaking=None if speech is None else speech.speaking, n_frames=n_frames, rules=rules,
-        report=lambda done: step(1 + done))
+        report=lambda done: step(1 + done), liveliness=liveliness)
     return Animation(
         faps=stream,
         audio=storyboard.speech.audio if storyboard.speech else None,
@@ -143,9 +147,35 @@ def _animate(
     )
 
 
+def _expression_track(storyboard: Storyboard, n_frames: int,
+                      rules: SyncRules) -> tuple[FapTrack, expressions.MoodCurves | None]:
+    """The expression track with the storyboard's moods blended under it, and the moods."""
+    fps = storyboard.fps
+    library = expressions.default_library().with_defs(
+        storyboard.expression_defs, mixes=storyboard.expression_mixes)
+    moods = (expressions.mood_curves(storyboard.moods, fps=fps, n_frames=n_frames,
+                                     library=library) if storyboard.moods else None)
+    track = expressions.animate(storyboard.expressions, fps=fps, n_frames=n_frames,
+                                library=library, importance=rules.expression_importance,
+                                moods=moods)
+    return track, moods
+
+
+def _with_mood(lively: Liveliness, moods: expressions.MoodCurves | None) -> Liveliness:
+    """``lively`` with the moods' idle amplitude on the micro-movements and their head
+    motion on the listening head motion, frame by frame (unchanged without moods)."""
+    if moods is None:
+        return lively
+    return replace(
+        lively,
+        micro_amplitude=lively.micro_amplitude * moods.scales["idle_amplitude"],
+        listening_amplitude=lively.listening_amplitude * moods.scales["head_motion_scale"])
+
+
 def compose(
     storyboard: Storyboard, *, visemes: FapTrack | None, speaking: np.ndarray | None,
     n_frames: int, rules: SyncRules, report: Callable[[int], None] | None = None,
+    liveliness: Liveliness | None = None,
 ) -> tuple[FapStream, dict[str, FapTrack], GazeAnimation]:
     """The expressions and the eyes of ``storyboard`` over ``n_frames`` frames, merged with
     the speech's ``visemes`` track (weights carrying importance, :func:`speech_track`;
@@ -154,7 +184,10 @@ def compose(
     ``n_frames``). Every generator is causal in its random draws, so a longer ``n_frames``
     or a cue starting at frame ``i`` leaves the frames before ``i`` bit for bit as they
     were: a live session runs this over a growing window. ``report(k)`` after each of the
-    three stages (expressions, gaze, synchronizer)."""
+    three stages (expressions, gaze, synchronizer). ``liveliness``: the idle motion's and
+    blink rate's factors (:class:`facelib.sync.Liveliness`; per-frame arrays must have
+    ``n_frames`` rows)."""
+    lively = liveliness or Liveliness()
     fps = storyboard.fps
     talking = np.zeros(n_frames, bool)
     viseme_track = FapTrack.empty(n_frames, fps=fps)
@@ -162,22 +195,20 @@ def compose(
         viseme_track = visemes.padded(n_frames)
     if speaking is not None:
         talking[: speaking.size] = speaking[:n_frames]
-    expression_track = expressions.animate(
-        storyboard.expressions, fps=fps, n_frames=n_frames,
-        library=expressions.default_library().with_defs(
-            storyboard.expression_defs, mixes=storyboard.expression_mixes
-        ),
-        importance=rules.expression_importance,
-    )
+    expression_track, moods = _expression_track(storyboard, n_frames, rules)
+    lively = _with_mood(lively, moods)
     if report is not None:
         report(1)
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
-                        behaviours=storyboard.gaze_defs, speaking=talking)
+                        behaviours=storyboard.gaze_defs, speaking=talking,
+                        blink_rate=lively.blink_rate)
     if report is not None:
         report(2)
     stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
                      blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=talking,
-                     rules=rules, seed=storyboard.seed)
+                     rules=rules, seed=storyboard.seed, liveliness=lively,
+                     head_scale=None if moods is None else moods.scales["head_motion_scale"],
+                     speech_brow=None if moods is None else moods.scales["speech_brow"])
     if report is not None:
         report(3)
     tracks = {"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track}

@@ -87,7 +87,7 @@ def test_speaking_makes_the_head_livelier():
 def test_combine_masks_driven_faps_in_every_frame():
     e = _track(open_jaw=(100, 1))
     e = FapTrack(25, e.values, e.weight * np.array([[1], [0], [0], [1]], np.float32))
-    rules = SyncRules(head_noise=None)
+    rules = SyncRules(head_noise=None, alive=None)  # masks of the blend alone
     stream = combine(expressions=e, visemes=FapTrack.empty(4, fps=25),
                      gaze=FapTrack.empty(4, fps=25), rules=rules)
     assert stream.mask[:, JAW].all()
