@@ -500,7 +500,28 @@ class FaceRenderer:
         self._pieces = _cull_hidden_sides(
             split_parts(vertices, triangles, getattr(face, "parts", None)), vertices,
             triangles, face, self.look)
-        strength, power = _part_occlusion(self.look, self._pieces, len(vertices))
+        self._buffers(face, colors)
+        if framing is None:
+            framing = "head"
+        if isinstance(framing, str):
+            framing = framing_points(face, framing, look=self.look)
+        self.scene = self._build_scene(vertices, background, framing)
+        self._renderer: Any = None
+        self._scale = 1
+        self.antialias = "off"
+        self._primitives: list[Any] = []
+        self.rigid_pieces = rigid_pieces
+        self._groups = rigid_groups([p.vertex_ids for p in self._pieces], vertices, triangles)
+        self._at_rest = [False] * len(self._groups)
+        self._nodes: list[Any] = []
+        self.set_vertices(vertices)
+        if offscreen:
+            self._open(antialias)
+
+    def _buffers(self, face: Deformable, colors: np.ndarray) -> None:
+        """Per piece: linear colours with the occlusion factor in alpha, materials, hair
+        card coordinates and the interleaved vertex buffer they fill."""
+        strength, power = _part_occlusion(self.look, self._pieces, len(colors))
         # the occlusion darkens the albedo, and rides in the colour's alpha for the face
         # shader to dim the highlights too (no gloss deep in the mouth); pyrender blends
         # nothing with it (its blend function is ONE, ZERO for opaque materials)
@@ -518,22 +539,6 @@ class FaceRenderer:
             buf[:, -4:] = color
             if uv is not None:
                 buf[:, 6:8] = uv
-        if framing is None:
-            framing = "head"
-        if isinstance(framing, str):
-            framing = framing_points(face, framing, look=self.look)
-        self.scene = self._build_scene(vertices, background, framing)
-        self._renderer: Any = None
-        self._scale = 1
-        self.antialias = "off"
-        self._primitives: list[Any] = []
-        self.rigid_pieces = rigid_pieces
-        self._groups = rigid_groups([p.vertex_ids for p in self._pieces], vertices, triangles)
-        self._at_rest = [False] * len(self._groups)
-        self._nodes: list[Any] = []
-        self.set_vertices(vertices)
-        if offscreen:
-            self._open(antialias)
 
     def _context(self, scale: int) -> Any:
         try:
