@@ -1,13 +1,22 @@
-"""Rendering speed on this machine: offscreen frames per second, per-frame mesh update cost,
-and the time to turn a 10 s ``.fap`` into an MP4 relative to its duration.
+"""Rendering speed on this machine: offscreen frames per second of the bare head and of the
+default character (hair and bust), against a minimal renderer of the same mesh; per-frame
+mesh update cost; the time to turn a 10 s ``.fap`` into an MP4 relative to its duration.
 
 Run: ``PYTHONPATH=. python benchmarks/render_speed.py [--platform osmesa|egl] [--size 640x480]
-[--antialias auto|msaa|supersample|off]`` (the platform must be chosen before OpenGL loads, so
-each platform is its own run). The anti-aliasing mode (``FaceRenderer(antialias=...)``)
-applies to every figure; the line per mesh update names the mode in use. The CPU time a frame
-(all threads of the process, llvmpipe's included) varies less with other jobs on a shared
-machine than the wall time does: on two idle cores a frame takes between half of it (both
-cores busy rendering) and all of it.
+[--antialias auto|msaa|supersample|off] [--rounds 5] [--images DIR]`` (the platform must be
+chosen before OpenGL loads, so each platform is its own run). The anti-aliasing mode
+(``FaceRenderer(antialias=...)``) applies to every figure. The ceiling is
+``render_ceiling.py`` (moderngl on EGL, llvmpipe; ``pip install moderngl``, or it is left
+out).
+
+The CPU time a frame (all threads of the process, llvmpipe's included) varies less with
+other jobs on a shared machine than the wall time does, so every figure is a median of
+``--rounds`` rounds that alternate the renderers in one process. llvmpipe draws on the main
+thread (vertex shading, binning) and rasterises on one thread per core, so on two idle cores
+a frame takes about the main thread's CPU time plus half the rest: the "2 idle cores"
+estimate. "hair double-sided, all uploaded" is the renderer before the speed work of issue
+33 (every hair card drawn from both sides, every vertex uploaded and its normal recomputed
+each frame), kept to show what that work buys.
 """
 
 from __future__ import annotations
@@ -40,31 +49,203 @@ def _timed(fn, repeat: int) -> float:
     return (time.perf_counter() - start) / repeat
 
 
+def _bare_face():
+    """The default head without bust and hair: its definition minus those two entries, in a
+    temporary folder beside copies of its files."""
+    import json
+    import shutil
+
+    from facelib import data
+    from facelib.engine import load_face
+
+    folder = Path(tempfile.mkdtemp())
+    head = data.path("head")
+    for name in (p.name for p in Path(str(head)).iterdir()):
+        shutil.copy(str(head / name), folder / name)
+    doc = json.loads((folder / "default_head.json").read_text())
+    doc.pop("bust", None)
+    doc.pop("hair", None)
+    (folder / "default_head.json").write_text(json.dumps(doc))
+    face = load_face(folder / "default_head.json")
+    shutil.rmtree(folder)
+    return face
+
+
+def _double_sided_look():
+    """The look with the hair drawn double-sided everywhere (before issue 33's speed work)."""
+    import dataclasses
+    from types import MappingProxyType
+
+    from facelib.rendering.scene import load_look
+
+    look = load_look()
+    parts = {k: {n: v for n, v in spec.items() if n != "single_sided_within_es"}
+             for k, spec in look.parts.items()}
+    return dataclasses.replace(look, parts=MappingProxyType(parts))
+
+
+class _InProcess:
+    """A FaceRenderer measured in this process."""
+
+    def __init__(self, renderer, vertices: np.ndarray):
+        self.renderer, self.vertices = renderer, vertices
+        self.mode = renderer.antialias
+        renderer.frame(vertices[0])  # warm up: shaders compiled, buffers made
+
+    def measure(self, frames: int) -> tuple[float, float]:
+        start, start_main = time.process_time(), time.thread_time()
+        for i in range(frames):
+            self.renderer.frame(self.vertices[i % len(self.vertices)])
+        return ((time.process_time() - start) / frames,
+                (time.thread_time() - start_main) / frames)
+
+    def image(self, path: Path) -> None:
+        import imageio.v3 as iio
+
+        iio.imwrite(path, self.renderer.frame(self.vertices[0]))
+
+    def close(self) -> None:
+        self.renderer.close()
+
+
+class _Child:
+    """The ceiling (render_ceiling.py) in a child process, measured there."""
+
+    def __init__(self, label: str, args, samples: int, renderer):
+        import subprocess
+        import sys
+
+        here = Path(__file__).resolve().parent
+        camera = renderer.scene.main_camera_node.camera
+        mvp = camera.get_projection_matrix(renderer.width, renderer.height) @ np.linalg.inv(
+            renderer.camera_pose)
+        command = [sys.executable, str(here / "render_ceiling.py"), label, args.size,
+                   str(samples), str(args.frames), ",".join(repr(float(v)) for v in mvp.ravel())]
+        self.process = subprocess.Popen(
+            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+            env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                [str(here), os.environ.get("PYTHONPATH", "")])})
+        self.mode = self._answer()
+
+    def _answer(self) -> str:
+        line = self.process.stdout.readline()
+        if not line:
+            raise RuntimeError("the ceiling's process ended (is moderngl installed, does "
+                               "EGL work?)")
+        return line.strip()
+
+    def measure(self, frames: int) -> tuple[float, float]:
+        self.process.stdin.write("run\n")
+        self.process.stdin.flush()
+        cpu, main = self._answer().split()
+        return float(cpu), float(main)
+
+    def image(self, path: Path) -> None:
+        self.process.stdin.write(f"image {path}\n")
+        self.process.stdin.flush()
+        self._answer()
+
+    def close(self) -> None:
+        self.process.stdin.write("quit\n")
+        self.process.stdin.close()
+        self.process.wait()
+
+
+def _renderers(faces: dict, stream, args, width: int, height: int) -> dict:
+    """name -> measured renderer: per face, the FaceRenderer, for the default face also the
+    renderer before issue 33's speed work, and the ceiling."""
+    from facelib.rendering.scene import FaceRenderer
+
+    out: dict = {}
+    for label, face in faces.items():
+        vertices = face.deform(stream[: args.frames])
+        for tag, options in (("", {}), (", hair double-sided, all uploaded",
+                                        {"look": _double_sided_look(), "rigid_pieces": False})):
+            if tag and label == "bare":
+                continue
+            r = FaceRenderer(face, width=width, height=height, antialias=args.antialias,
+                             **options)
+            out[f"{label}{tag}"] = _InProcess(r, vertices)
+        samples = 0 if out[label].mode == "off" else 4
+        try:
+            out[f"{label}: ceiling"] = _Child(label, args, samples, out[label].renderer)
+        except RuntimeError as exc:
+            print(f"no ceiling for {label}: {exc}")
+    return out
+
+
+def _side_by_side(renderers: dict, rounds: int, frames: int) -> dict:
+    """name -> (median CPU a frame, median main-thread CPU a frame), seconds."""
+    cpu: dict[str, list[float]] = {k: [] for k in renderers}
+    main: dict[str, list[float]] = {k: [] for k in renderers}
+    for _ in range(rounds):
+        for name, renderer in renderers.items():
+            c, m = renderer.measure(frames)
+            cpu[name].append(c)
+            main[name].append(m)
+    return {k: (float(np.median(cpu[k])), float(np.median(main[k]))) for k in renderers}
+
+
+def _report(renderers: dict, figures: dict, images: str | None) -> None:
+    for name, (cpu, main) in figures.items():
+        label = name.split(":")[0].split(",")[0]
+        ceiling = figures.get(f"{label}: ceiling")
+        ratio = f", {ceiling[0] / cpu:4.2f} of the ceiling" if ceiling and ":" not in name else ""
+        idle = main + (cpu - main) / 2
+        print(f"  {name:38s} CPU {cpu * 1e3:6.1f} ms a frame = {1 / cpu:5.1f} frames/s; "
+              f"2 idle cores ~{idle * 1e3:5.1f} ms = {1 / idle:5.1f} frames/s{ratio}")
+    if images:
+        Path(images).mkdir(parents=True, exist_ok=True)
+        for name, renderer in renderers.items():
+            slug = "".join(c if c.isalnum() else "_" for c in name)
+            renderer.image(Path(images).resolve() / f"{slug}.png")
+
+
+def _side_by_side_figures(faces: dict, stream, args, width: int, height: int) -> None:
+    renderers = _renderers(faces, stream, args, width, height)
+    ceiling = [r.mode for r in renderers.values() if isinstance(r, _Child)]
+    print(f"side by side ({renderers['default'].mode}; medians of {args.rounds} rounds of "
+          f"{args.frames} frames{'; ceiling on ' + ceiling[0] if ceiling else ''}):")
+    _report(renderers, _side_by_side(renderers, args.rounds, args.frames), args.images)
+    for renderer in renderers.values():
+        renderer.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--platform", choices=["osmesa", "egl"], default=None)
     parser.add_argument("--size", default="640x480")
-    parser.add_argument("--frames", type=int, default=60)
+    parser.add_argument("--frames", type=int, default=30)
+    parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--antialias", default="auto",
                         choices=["auto", "msaa", "supersample", "off"])
+    parser.add_argument("--images", default=None, help="write each renderer's first frame here")
     args = parser.parse_args()
     if args.platform:
         os.environ["PYOPENGL_PLATFORM"] = args.platform
     width, height = (int(v) for v in args.size.split("x"))
 
+    from machine import describe
+
     from facelib.engine import load_face
+    from facelib.rendering.platform import choose_platform
+
+    faces = {"bare": _bare_face(), "default": load_face(None)}
+    stream = _stream(args.seconds, 25)
+    print(f"platform {choose_platform()}, {width}x{height}; {describe()}")
+    for label, face in faces.items():
+        print(f"  {label}: {len(face.vertices)} vertices, {len(face.triangles)} triangles")
+    _side_by_side_figures(faces, stream, args, width, height)
+    _update_figures(faces["default"], stream, args, width, height)
+
+
+def _update_figures(face, stream, args, width: int, height: int) -> None:
     from facelib.mpeg4.fapfile import read_fap, write_fap
     from facelib.rendering.frames import render
-    from facelib.rendering.platform import choose_platform
     from facelib.rendering.scene import FaceRenderer
 
-    face = load_face(None)
-    stream = _stream(args.seconds, 25)
     vertices = face.deform(stream[: args.frames])
-    print(f"platform {choose_platform()}, face {len(face.vertices)} vertices "
-          f"{len(face.triangles)} triangles, {width}x{height}, {os.cpu_count()} CPUs")
-
     for method in ("buffers", "swap"):
         with FaceRenderer(face, width=width, height=height, mesh_update=method,
                           antialias=args.antialias) as r:

@@ -31,13 +31,15 @@ from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
-import scipy.sparse as sp
 
 from facelib import data
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import FaceModelError, ParameterError, RenderError
+from facelib.rendering.normals import normal_operator, vertex_normals
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
+from facelib.rendering.readback import install_colour_readback
+from facelib.rendering.rigid_pieces import RigidGroup, rigid_groups, rigid_pose
 
 __all__ = [
     "ANTIALIAS",
@@ -161,11 +163,13 @@ class PartMesh:
     vertex_ids: ``(Vp,) int64`` global vertex ids used by this piece, sorted.
     triangles: ``(Fp, 3) uint32`` indices into ``vertex_ids``, wound counter-clockwise seen
         from outside.
+    double_sided: whether both faces are drawn; None: as the part's material says.
     """
 
     name: str
     vertex_ids: np.ndarray
     triangles: np.ndarray
+    double_sided: bool | None = None
 
 
 def _orient_outward(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -224,34 +228,6 @@ def split_parts(
         local = _orient_outward(vertices[ids], local)
         out.append(PartMesh(name, ids, local.astype(np.uint32)))
     return out
-
-
-def normal_operator(n_vertices: int, triangles: np.ndarray) -> sp.csr_matrix:
-    """``(V, F)`` sparse incidence matrix: vertex normal = sum of its triangles' normals."""
-    triangles = np.asarray(triangles, np.int64)
-    rows = triangles.ravel()
-    cols = np.repeat(np.arange(len(triangles)), 3)
-    weights = np.ones(len(rows), np.float32)
-    return sp.csr_matrix((weights, (rows, cols)), shape=(n_vertices, len(triangles)))
-
-
-def vertex_normals(
-    vertices: np.ndarray, triangles: np.ndarray, operator: sp.csr_matrix | None = None
-) -> np.ndarray:
-    """Smooth unit normals ``(V, 3) float32``: area-weighted mean of adjacent face normals.
-
-    ``vertices`` ``(V, 3)``, ``triangles`` ``(F, 3)`` indices; pass ``operator`` from
-    :func:`normal_operator` to reuse it across frames. Vertices of no triangle get ``+z``.
-    """
-    vertices = np.asarray(vertices, np.float32)
-    triangles = np.asarray(triangles, np.int64)
-    if operator is None:
-        operator = normal_operator(len(vertices), triangles)
-    a, b, c = (vertices[triangles[:, k]] for k in range(3))
-    summed = operator @ np.cross(b - a, c - a)
-    length = np.linalg.norm(summed, axis=1, keepdims=True)
-    normals = np.where(length > 0, summed / np.maximum(length, 1e-30), (0.0, 0.0, 1.0))
-    return normals.astype(np.float32)
 
 
 def frame_camera(
@@ -323,6 +299,43 @@ def _occlusion_factor(n: int, occlusion: Any, strength: np.ndarray | float,
     if occlusion.shape != (n,):
         raise FaceModelError(f"face vertex_ao must have shape ({n},), got {occlusion.shape}")
     return occlusion_factor(occlusion, strength=strength, power=power)
+
+
+def _sub_piece(piece: PartMesh, local: np.ndarray, *, double_sided: bool) -> PartMesh:
+    """The part of ``piece`` that triangles ``local`` ``(F, 3)`` (indices into its
+    ``vertex_ids``) use, re-indexed to its own vertices."""
+    used = np.unique(local)
+    return PartMesh(piece.name, piece.vertex_ids[used],
+                    np.searchsorted(used, local).astype(np.uint32), double_sided)
+
+
+def _cull_hidden_sides(pieces: list[PartMesh], vertices: np.ndarray, triangles: np.ndarray,
+                       face: Any, look: Look) -> list[PartMesh]:
+    """``pieces`` with each part whose material sets ``single_sided_within_es`` cut by
+    :func:`facelib.rendering.hair.split_hair` into a single-sided piece (the triangles
+    within that many eye separations of the other parts) and a double-sided rest. A face
+    without FAPU (``face.fapu["ES"]``) keeps its pieces."""
+    from facelib.rendering.hair import split_hair
+
+    es = (getattr(face, "fapu", None) or {}).get("ES")
+    wanted = [p for p in pieces if look.material(p.name).get("single_sided_within_es")]
+    if es is None or not wanted:
+        return pieces
+    normals = vertex_normals(vertices, triangles)
+    out: list[PartMesh] = []
+    for piece in pieces:
+        within = float(look.material(piece.name).get("single_sided_within_es", 0.0))
+        if piece not in wanted:
+            out.append(piece)
+            continue
+        others = np.ones(len(vertices), bool)
+        others[piece.vertex_ids] = False
+        single, double = split_hair(vertices[piece.vertex_ids], piece.triangles,
+                                    vertices[others], normals[others],
+                                    within=within * 1024.0 * float(es))
+        out += [_sub_piece(piece, tris, double_sided=sides)
+                for tris, sides in ((single, False), (double, True)) if len(tris)]
+    return out
 
 
 def _piece_uv(pieces: Sequence[PartMesh], hair_uv: Any) -> list[np.ndarray | None]:
@@ -450,6 +463,9 @@ class FaceRenderer:
         ``"msaa"``, ``"supersample"`` (render ``look.supersample`` times larger and average
         blocks) or ``"off"``. pyrender always multisamples on EGL, whatever this says.
         :attr:`antialias` tells the mode in use.
+    rigid_pieces: move pieces that moved rigidly by their node's pose instead of uploading
+        their vertices (``mesh_update="buffers"`` only; the images differ by float
+        rounding at most).
     """
 
     def __init__(
@@ -464,6 +480,7 @@ class FaceRenderer:
         mesh_update: Literal["buffers", "swap"] = "buffers",
         offscreen: bool = True,
         antialias: Literal["auto", "msaa", "supersample", "off"] = "auto",
+        rigid_pieces: bool = True,
     ):
         for label, value in (("width", width), ("height", height)):
             if not isinstance(value, (int, np.integer)) or not 8 <= value <= 8192:
@@ -480,25 +497,10 @@ class FaceRenderer:
         self.n_vertices = len(vertices)
         self._triangles = triangles
         self._normal_op = normal_operator(self.n_vertices, triangles)
-        self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
-        strength, power = _part_occlusion(self.look, self._pieces, len(vertices))
-        # the occlusion darkens the albedo, and rides in the colour's alpha for the face
-        # shader to dim the highlights too (no gloss deep in the mouth); pyrender blends
-        # nothing with it (its blend function is ONE, ZERO for opaque materials)
-        factor = _occlusion_factor(len(colors), getattr(face, "vertex_ao", None),
-                                   strength, power)
-        linear = srgb_to_linear(colors) * factor[:, None]
-        self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
-                        for p in self._pieces]
-        self._materials = [self._material(p.name) for p in self._pieces]
-        self._uv = _piece_uv(self._pieces, getattr(face, "hair_uv", None))
-        # pyrender interleaves position, normal, texcoord_0 (hair only) and colour
-        self._interleaved = [np.empty((len(c), 10 if uv is None else 12), np.float32)
-                             for c, uv in zip(self._colors, self._uv, strict=True)]
-        for buf, color, uv in zip(self._interleaved, self._colors, self._uv, strict=True):
-            buf[:, -4:] = color
-            if uv is not None:
-                buf[:, 6:8] = uv
+        self._pieces = _cull_hidden_sides(
+            split_parts(vertices, triangles, getattr(face, "parts", None)), vertices,
+            triangles, face, self.look)
+        self._buffers(face, colors)
         if framing is None:
             framing = "head"
         if isinstance(framing, str):
@@ -508,10 +510,35 @@ class FaceRenderer:
         self._scale = 1
         self.antialias = "off"
         self._primitives: list[Any] = []
+        self.rigid_pieces = rigid_pieces
+        self._groups = rigid_groups([p.vertex_ids for p in self._pieces], vertices, triangles)
+        self._at_rest = [False] * len(self._groups)
         self._nodes: list[Any] = []
         self.set_vertices(vertices)
         if offscreen:
             self._open(antialias)
+
+    def _buffers(self, face: Deformable, colors: np.ndarray) -> None:
+        """Per piece: linear colours with the occlusion factor in alpha, materials, hair
+        card coordinates and the interleaved vertex buffer they fill."""
+        strength, power = _part_occlusion(self.look, self._pieces, len(colors))
+        # the occlusion darkens the albedo, and rides in the colour's alpha for the face
+        # shader to dim the highlights too (no gloss deep in the mouth); pyrender blends
+        # nothing with it (its blend function is ONE, ZERO for opaque materials)
+        factor = _occlusion_factor(len(colors), getattr(face, "vertex_ao", None),
+                                   strength, power)
+        linear = srgb_to_linear(colors) * factor[:, None]
+        self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
+                        for p in self._pieces]
+        self._materials = [self._material(p) for p in self._pieces]
+        self._uv = _piece_uv(self._pieces, getattr(face, "hair_uv", None))
+        # pyrender interleaves position, normal, texcoord_0 (hair only) and colour
+        self._interleaved = [np.empty((len(c), 10 if uv is None else 12), np.float32)
+                             for c, uv in zip(self._colors, self._uv, strict=True)]
+        for buf, color, uv in zip(self._interleaved, self._colors, self._uv, strict=True):
+            buf[:, -4:] = color
+            if uv is not None:
+                buf[:, 6:8] = uv
 
     def _context(self, scale: int) -> Any:
         try:
@@ -522,6 +549,7 @@ class FaceRenderer:
                 f"OpenGL context ({type(exc).__name__}: {exc}); {INSTALL_HINT}"
             ) from exc
         install_program_cache(self._pr, renderer._renderer, self.look)
+        install_colour_readback(renderer)
         return renderer
 
     def _open(self, antialias: str) -> None:
@@ -547,13 +575,14 @@ class FaceRenderer:
 
     # -- scene construction -----------------------------------------------------------
 
-    def _material(self, part: str) -> Any:
-        spec = self.look.material(part)
+    def _material(self, piece: PartMesh) -> Any:
+        spec = self.look.material(piece.name)
+        sides = piece.double_sided
         return self._pr.MetallicRoughnessMaterial(
             baseColorFactor=(1.0, 1.0, 1.0, 1.0),
             metallicFactor=float(spec.get("metallic", 0.0)),
             roughnessFactor=float(spec.get("roughness", 0.6)),
-            doubleSided=bool(spec.get("double_sided", False)),
+            doubleSided=bool(spec.get("double_sided", False)) if sides is None else sides,
         )
 
     def _build_scene(
@@ -602,7 +631,12 @@ class FaceRenderer:
     # -- per-frame update ----------------------------------------------------------------
 
     def set_vertices(self, vertices: np.ndarray) -> None:
-        """Move the face to ``vertices`` ``(V, 3)`` (recomputing smooth normals)."""
+        """Move the face to ``vertices`` ``(V, 3)`` (recomputing smooth normals).
+
+        With ``mesh_update="buffers"``, a group of pieces that moved rigidly from its rest
+        shape (hair, eyeballs, teeth; see :mod:`facelib.rendering.rigid_pieces`) is moved
+        by its nodes' pose instead, its buffers keeping the rest shape.
+        """
         vertices = np.asarray(vertices, np.float32)
         if vertices.shape != (self.n_vertices, 3):
             raise ParameterError(
@@ -610,33 +644,57 @@ class FaceRenderer:
             )
         if not np.isfinite(vertices).all():
             raise ParameterError("vertices must be finite")
-        normals = vertex_normals(vertices, self._triangles, self._normal_op)
         uploaded = self._primitives and all(p._vaid is not None for p in self._primitives)
         if self.mesh_update == "buffers" and uploaded and self._renderer is not None:
-            self._upload(vertices, normals)
+            self._renderer._platform.make_current()
+            for k, group in enumerate(self._groups):
+                self._move_group(k, group, vertices)
+            from OpenGL import GL
+
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
             return
+        normals = vertex_normals(vertices, self._triangles, self._normal_op)
         for node in self._nodes:
             self.scene.remove_node(node)
         meshes = self._new_meshes(vertices, normals)
         self._primitives = [m.primitives[0] for m in meshes]
         self._nodes = [self.scene.add(m) for m in meshes]
+        self._at_rest = [False] * len(self._groups)
 
-    def _upload(self, vertices: np.ndarray, normals: np.ndarray) -> None:
+    def _move_group(self, k: int, group: RigidGroup, vertices: np.ndarray) -> None:
+        """Pose group ``k`` rigidly where it moved so, else upload its vertices."""
+        pose = rigid_pose(group, vertices) if self.rigid_pieces else None
+        if pose is not None:
+            if not self._at_rest[k]:
+                rest = group.rest.astype(np.float32)
+                normals = vertex_normals(rest, group.triangles, group.operator)
+                self._upload(group, rest, normals)
+                self._at_rest[k] = True
+            for piece in group.pieces:
+                self.scene.set_pose(self._nodes[piece], pose)
+            return
+        mine = vertices[group.vertex_ids]
+        self._upload(group, mine, vertex_normals(mine, group.triangles, group.operator))
+        if self._at_rest[k]:
+            for piece in group.pieces:
+                self.scene.set_pose(self._nodes[piece], np.eye(4))
+            self._at_rest[k] = False
+
+    def _upload(self, group: RigidGroup, vertices: np.ndarray, normals: np.ndarray) -> None:
+        """Rewrite the vertex buffers of ``group``'s pieces: ``vertices`` and ``normals``
+        ``(Vg, 3)`` in the rows of ``group.vertex_ids``."""
         from OpenGL import GL
 
-        assert self._renderer is not None  # _update only uploads to a live renderer
-        self._renderer._platform.make_current()
-        for piece, prim, buf in zip(self._pieces, self._primitives, self._interleaved,
-                                    strict=True):
-            buf[:, 0:3] = vertices[piece.vertex_ids]
-            buf[:, 3:6] = normals[piece.vertex_ids]
+        for piece, rows in zip(group.pieces, group.rows, strict=True):
+            prim, buf = self._primitives[piece], self._interleaved[piece]
+            buf[:, 0:3] = vertices[rows]
+            buf[:, 3:6] = normals[rows]
             # keep the primitive's own arrays (bounds, shadows) true to what is drawn
             prim._positions = buf[:, 0:3]
             prim._normals = buf[:, 3:6]
             prim._bounds = None
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, prim._buffers[0])
             GL.glBufferSubData(GL.GL_ARRAY_BUFFER, 0, buf.nbytes, buf)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
 
     def frame(self, vertices: np.ndarray | None = None) -> np.ndarray:
         """Render ``vertices`` ``(V, 3)`` (or the current pose) to ``(H, W, 3) uint8`` RGB."""
