@@ -32,7 +32,7 @@ $(WEB)/node_modules/.installed: $(WEB)/package.json $(WEB)/package-lock.json
 	cd $(WEB) && npm ci --no-audit --no-fund
 	touch $@
 
-$(WEB)/dist/player.js: $(WEB)/node_modules/.installed $(WEB)/src/player.js
+$(WEB)/dist/player.js: $(WEB)/node_modules/.installed $(wildcard $(WEB)/src/*.js)
 	cd $(WEB) && npm run --silent build
 
 # Debian packages first (tools/debian-deps installs them as root, otherwise prints the

@@ -23,7 +23,8 @@ def add(commands: Any) -> None:
                         help="write ARKit-52 blendshape curves instead of glTF")
     export.add_argument("--targets", choices=("fap", "arkit"), default="fap",
                         help="glTF morph targets: one per FAP basis vector (fap, the default) or "
-                             "the 52 ARKit-named shapes of the head (arkit)")
+                             "the 52 ARKit-named shapes of the head (arkit; also for --html, "
+                             "which the live page of examples/live needs)")
     export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
     export.add_argument("--vrm", metavar="OUT.vrm",
                         help="also write a VRM 1.0 avatar of the head (expression presets aa ... "
@@ -68,6 +69,7 @@ def _export(args: argparse.Namespace, console: Console) -> int:
         console.status(f"wrote {avatar.path} (VRM 1.0: {len(avatar.presets)} expression "
                        f"presets, {len(avatar.bones)} humanoid bones)")
     if args.html is not None:
-        page = export.export_html(source, args.html, face=face, audio=args.audio)
+        page = export.export_html(source, args.html, face=face, audio=args.audio,
+                                   targets=args.targets)
         console.status(f"wrote {page.page} (open it in a browser)")
     return EXIT_OK

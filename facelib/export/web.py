@@ -44,11 +44,15 @@ def export_html(
     *,
     face: Face | None = None,
     audio: str | os.PathLike[str] | None = None,
+    targets: str = "fap",
 ) -> WebExport:
     """Write a web player for ``source`` into the folder ``out_dir`` (created if missing).
 
-    ``source``, ``face`` and ``audio`` as for :func:`facelib.export.export_gltf`. The page
-    has play/pause, a time slider for scrubbing and orbit (drag), zoom (wheel) and pan.
+    ``source``, ``face``, ``audio`` and ``targets`` as for
+    :func:`facelib.export.export_gltf`. The page has play/pause, a time slider for scrubbing
+    and orbit (drag), zoom (wheel) and pan. With ``targets="arkit"`` the folder is also the
+    head of the live page (``examples/live/``, ``docs/live.md``): it sets the 52 ARKit
+    weights of a ``facelib serve`` session's frames on the morph targets.
     """
     if not _BUNDLE.is_file():
         raise FacelibError(f"the web player is not built ({_BUNDLE} is missing): run "
@@ -56,7 +60,7 @@ def export_html(
                            f"{WEB_DIR}")
     folder = output_folder(out_dir)
     clip = export_clip(source, face=face, audio=audio)
-    result = export_gltf(clip, folder / "face.glb")
+    result = export_gltf(clip, folder / "face.glb", targets=targets)
     look = data.json_data("render_look.json")
     scene = {
         "glb": base64.b64encode(result.path.read_bytes()).decode("ascii"),

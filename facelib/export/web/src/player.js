@@ -4,6 +4,7 @@
 import * as THREE from "three";
 import { GLTFLoader } from "three/examples/jsm/loaders/GLTFLoader.js";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { arkitMeshes, connectLive } from "./live.js";
 
 const scene = window.FACELIB_SCENE; // {glb: base64, look: {...}, audio, audioOffset}
 const params = new URLSearchParams(window.location.search);
@@ -23,6 +24,11 @@ function lightDirection(azimuthDeg, elevationDeg) {
 
 function setUp() {
   const canvas = document.getElementById("view");
+  const size = /^(\d+)x(\d+)$/.exec(params.get("size") || ""); // ?size=320x240: a smaller view
+  if (size) {
+    [canvas.width, canvas.height] = [Number(size[1]), Number(size[2])];
+    Object.assign(canvas.style, { width: `${size[1]}px`, height: `${size[2]}px` });
+  }
   const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   const look = scene.look;
@@ -63,6 +69,49 @@ async function main() {
   const v = setUp();
   const gltf = await new GLTFLoader().parseAsync(decode(scene.glb), "");
   v.world.add(gltf.scene);
+  if (document.body.dataset.live !== undefined) return liveMode(v, gltf);
+  return fileMode(v, gltf);
+}
+
+function frameScene(v, gltf) {
+  gltf.scene.updateMatrixWorld(true);
+  const box = new THREE.Box3();
+  gltf.scene.traverse((o) => { if (o.isMesh) { o.frustumCulled = false; box.expandByObject(o); } });
+  frameCamera(v, box);
+}
+
+// the page of examples/live: a server URL (?server=ws://...), a line to say, the head
+function liveMode(v, gltf) {
+  frameScene(v, gltf); // the rest pose: the live frames set only the morph targets
+  const head = arkitMeshes(gltf.scene);
+  const status = document.getElementById("status");
+  const server = document.getElementById("server");
+  const line = document.getElementById("line");
+  server.value = params.get("server") || server.value;
+  const draw = () => v.renderer.render(v.world, v.camera);
+  draw.canvas = v.canvas;
+  const onStatus = (text) => { status.textContent = text; };
+  let live = null;
+  function connect() {
+    if (live) live.close();
+    live = connectLive(server.value, head, draw, { onStatus });
+    window.facelibPlayer.live = live;
+  }
+  function say() {
+    if (!live) connect();
+    const text = line.value.trim();
+    if (text) live.say(text);
+    line.value = "";
+  }
+  document.getElementById("connect").addEventListener("click", connect);
+  document.getElementById("say").addEventListener("click", say);
+  line.addEventListener("keydown", (e) => { if (e.key === "Enter") say(); });
+  window.facelibPlayer = { live: null, connect };
+  connect();
+  document.body.dataset.ready = "1";
+}
+
+function fileMode(v, gltf) {
   const mixer = new THREE.AnimationMixer(gltf.scene);
   const clip = gltf.animations[0];
   const duration = scene.nFrames > 1 ? (scene.nFrames - 1) / scene.fps : 0;
@@ -72,10 +121,7 @@ async function main() {
     action.clampWhenFinished = true;
     action.play();
   }
-  gltf.scene.updateMatrixWorld(true);
-  const box = new THREE.Box3();
-  gltf.scene.traverse((o) => { if (o.isMesh) { o.frustumCulled = false; box.expandByObject(o); } });
-  frameCamera(v, box);
+  frameScene(v, gltf);
 
   const audio = document.getElementById("audio");
   const slider = document.getElementById("scrub");
