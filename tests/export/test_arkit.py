@@ -205,3 +205,13 @@ def test_residual_per_region(hello):
     # the tongue is carried only as TongueOut: most of its motion is lost, and it says so
     assert residuals["tongue_tip"].relative > 0.3
     assert np.isnan(residuals["ear_top_l"].relative)  # no motion without the head turn
+
+
+def test_arkit_targets_come_in_the_order_of_the_weights():
+    """The live page (examples/live) sets a frame's 52 weights on an ARKit export's morph
+    targets by position: both lists must name the same shapes in the same order."""
+    from facelib.export.arkit import arkit_names
+    from facelib.export.arkit_targets import arkit_target_names
+
+    assert [n.lower() for n in arkit_names()] == [n.lower() for n in arkit_target_names()]
+    assert len(arkit_target_names()) == 52
