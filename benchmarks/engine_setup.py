@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from facelib.engine import default_face
-from facelib.engine.headmesh import HeadMesh, head_mesh, load_head_mesh
 from facelib.engine.setup import read_landmarks, set_up_face
-from facelib.engine.tps import fit_tps
+from facelib.engine.setup.headmesh import HeadMesh, head_mesh, load_head_mesh
+from facelib.engine.setup.tps import fit_tps
 
 HEADS = Path(__file__).resolve().parent.parent / "examples" / "heads"
 

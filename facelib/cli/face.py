@@ -54,8 +54,8 @@ def _write_found(found: Any, folder: Path, console: Console) -> None:
 
 
 def _face_setup(args: argparse.Namespace, console: Console) -> int:
-    from facelib.engine.headmesh import load_head_mesh
     from facelib.engine.setup import set_up_face
+    from facelib.engine.setup.headmesh import load_head_mesh
     from facelib.engine.writer import write_face
 
     if (args.landmarks is None) == (not args.auto):

@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 
 from facelib import data
+from facelib.engine.deformers import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, RIGID_DEFORMERS, Face, Region
 from facelib.engine.meshfile import mesh_path, read_npz
-from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FacelibError, FaceModelError, ParameterError
 from facelib.mpeg4.tables import fap, fap_table, feature_point_table

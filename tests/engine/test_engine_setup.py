@@ -14,8 +14,8 @@ import pytest
 from facelib.cli import main
 from facelib.engine import default_face, load_face
 from facelib.engine.face import PART_NAMES
-from facelib.engine.headmesh import head_mesh, load_head_mesh
 from facelib.engine.setup import read_landmarks, set_up_face, setup_face
+from facelib.engine.setup.headmesh import head_mesh, load_head_mesh
 from facelib.errors import FaceModelError, ParameterError
 
 ROOT = Path(__file__).resolve().parents[2]

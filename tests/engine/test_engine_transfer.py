@@ -11,11 +11,11 @@ import pytest
 
 from facelib.engine import default_face, load_face
 from facelib.engine.face import PART_NAMES
-from facelib.engine.headmesh import head_mesh, load_head_mesh
 from facelib.engine.quality import mean_roughness
 from facelib.engine.setup import read_landmarks, set_up_face, setup_face
+from facelib.engine.setup.headmesh import head_mesh, load_head_mesh
+from facelib.engine.setup.tps import fit_tps
 from facelib.engine.surface import closest_points, surface, vertex_normals
-from facelib.engine.tps import fit_tps
 from facelib.engine.writer import write_face
 from facelib.visemes.tables import viseme_targets
 

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from facelib.engine.headmesh import axes_rotation, head_mesh, load_head_mesh
 from facelib.engine.setup import read_landmarks, set_up_face
+from facelib.engine.setup.headmesh import axes_rotation, head_mesh, load_head_mesh
 from facelib.errors import FaceModelError
 
 pytest.importorskip("mediapipe")

@@ -2,7 +2,7 @@
 
 ``setup_face(mesh, landmarks=...)`` finds the mesh's unit and orientation from the
 landmarks, fits the thin-plate spline from the source face's feature points to them, and
-transfers the source's whole face definition (see :mod:`facelib.engine.transfer`).
+transfers the source's whole face definition (see :mod:`facelib.engine.setup.transfer`).
 ``write_face`` stores the result as a normal face definition JSON plus mesh.
 """
 
@@ -19,10 +19,10 @@ import numpy as np
 
 from facelib.engine.definition import default_face
 from facelib.engine.face import Face
-from facelib.engine.headmesh import HeadMesh, axes_rotation, load_head_mesh
+from facelib.engine.setup.headmesh import HeadMesh, axes_rotation, load_head_mesh
+from facelib.engine.setup.tps import ThinPlateSpline, check_landmarks, fit_tps
+from facelib.engine.setup.transfer import transfer_face
 from facelib.engine.surface import Surface, closest_points, surface
-from facelib.engine.tps import ThinPlateSpline, check_landmarks, fit_tps
-from facelib.engine.transfer import transfer_face
 from facelib.errors import FaceModelError, ParameterError
 
 __all__ = ["UNITS", "FaceSetup", "read_landmarks", "set_up_face", "setup_face"]
