@@ -167,11 +167,9 @@ def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarra
     return out
 
 
-def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """(V, 3) float32 unit area-weighted vertex normals ((0, 0, 1) where undefined)."""
-    out = surface.vertex_normals(vertices, triangles)
-    out[~out.any(axis=1)] = (0.0, 0.0, 1.0)
-    return out.astype(np.float32)
+def _normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(V, 3) float32 :func:`~facelib.engine.surface.vertex_normals` ((0, 0, 1) if undefined)."""
+    return surface.vertex_normals(vertices, triangles, unused=(0.0, 0.0, 1.0)).astype(np.float32)
 
 
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
@@ -179,9 +177,9 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     lib = b.lib
     look_data = data.json_data("render_look.json")
     look = look_data["parts"]
-    normals = vertex_normals(face.vertices, face.triangles)
+    normals = _normals(face.vertices, face.triangles)
     # each target's change of the normals, so that players shade the deformed face right
-    normal_turns = [vertex_normals(face.vertices + disp, face.triangles) - normals
+    normal_turns = [_normals(face.vertices + disp, face.triangles) - normals
                     for disp in targets]
     colours = _occluded(srgb_to_linear(face.vertex_colors), face, look_data)  # glTF's: linear
     joints = np.zeros((face.n_vertices, 4), np.uint16)

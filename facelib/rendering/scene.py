@@ -31,10 +31,10 @@ from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
-import scipy.sparse as sp
 
 from facelib import data
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
+from facelib.engine.surface import vertex_normals
 from facelib.errors import FaceModelError, ParameterError, RenderError
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
@@ -51,7 +51,6 @@ __all__ = [
     "install_program_cache",
     "load_look",
     "split_parts",
-    "vertex_normals",
 ]
 
 
@@ -217,34 +216,6 @@ def split_parts(
         local = _orient_outward(vertices[ids], local)
         out.append(PartMesh(name, ids, local.astype(np.uint32)))
     return out
-
-
-def normal_operator(n_vertices: int, triangles: np.ndarray) -> sp.csr_matrix:
-    """``(V, F)`` sparse incidence matrix: vertex normal = sum of its triangles' normals."""
-    triangles = np.asarray(triangles, np.int64)
-    rows = triangles.ravel()
-    cols = np.repeat(np.arange(len(triangles)), 3)
-    weights = np.ones(len(rows), np.float32)
-    return sp.csr_matrix((weights, (rows, cols)), shape=(n_vertices, len(triangles)))
-
-
-def vertex_normals(
-    vertices: np.ndarray, triangles: np.ndarray, operator: sp.csr_matrix | None = None
-) -> np.ndarray:
-    """Smooth unit normals ``(V, 3) float32``: area-weighted mean of adjacent face normals.
-
-    ``vertices`` ``(V, 3)``, ``triangles`` ``(F, 3)`` indices; pass ``operator`` from
-    :func:`normal_operator` to reuse it across frames. Vertices of no triangle get ``+z``.
-    """
-    vertices = np.asarray(vertices, np.float32)
-    triangles = np.asarray(triangles, np.int64)
-    if operator is None:
-        operator = normal_operator(len(vertices), triangles)
-    a, b, c = (vertices[triangles[:, k]] for k in range(3))
-    summed = operator @ np.cross(b - a, c - a)
-    length = np.linalg.norm(summed, axis=1, keepdims=True)
-    normals = np.where(length > 0, summed / np.maximum(length, 1e-30), (0.0, 0.0, 1.0))
-    return normals.astype(np.float32)
 
 
 def frame_camera(
@@ -463,7 +434,6 @@ class FaceRenderer:
         vertices, triangles, colors = _face_arrays(face)
         self.n_vertices = len(vertices)
         self._triangles = triangles
-        self._normal_op = normal_operator(self.n_vertices, triangles)
         self._pieces = split_parts(vertices, triangles, getattr(face, "parts", None))
         strength, power = _part_occlusion(self.look, self._pieces, len(vertices))
         # the occlusion darkens the albedo, and rides in the colour's alpha for the face
@@ -588,7 +558,8 @@ class FaceRenderer:
             )
         if not np.isfinite(vertices).all():
             raise ParameterError("vertices must be finite")
-        normals = vertex_normals(vertices, self._triangles, self._normal_op)
+        normals = vertex_normals(vertices, self._triangles, unused=(0.0, 0.0, 1.0))
+        normals = normals.astype(np.float32)
         uploaded = self._primitives and all(p._vaid is not None for p in self._primitives)
         if self.mesh_update == "buffers" and uploaded and self._renderer is not None:
             self._upload(vertices, normals)
