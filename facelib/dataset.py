@@ -45,6 +45,7 @@ import numpy as np
 from facelib.atomic import output_folder, write_text_atomic
 from facelib.checks import check_count, check_number, check_seed
 from facelib.errors import FacelibError, ParameterError
+from facelib.optional import missing_extra
 from facelib.progress import ProgressCallback, progress_callback
 
 __all__ = ["ClipDraw", "DatasetReport", "DatasetSpec", "draw_clip", "generate", "load_spec",
@@ -526,10 +527,7 @@ def _run_dask(spec: DatasetSpec, todo: Sequence[int], out_dir: str, scheduler: A
     try:
         from distributed import Client, as_completed
     except ImportError:
-        from facelib.errors import MissingExtraError
-
-        raise MissingExtraError("dataset generation on a Dask cluster", "scale",
-                                "distributed") from None
+        raise missing_extra("distributed") from None
     client = scheduler if isinstance(scheduler, Client) else Client(scheduler, timeout=30)
     try:
         futures = client.map(_clip_task, [spec] * len(todo), list(todo),

@@ -15,7 +15,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "facelib"
 
-BASE = {"errors", "checks", "atomic", "data", "progress"}
+BASE = {"errors", "checks", "atomic", "data", "progress", "optional"}
 GENERATORS = {"fdl", "speech", "visemes", "expressions", "gaze"}
 OUTPUTS = {"rendering", "tracking", "export"}
 TOP = {"batch", "dataset", "evaluate", "catalog", "cli", "plot", "__init__", "__main__"}

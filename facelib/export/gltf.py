@@ -20,12 +20,13 @@ from facelib import data
 from facelib.atomic import atomic_path
 from facelib.engine import Face, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
-from facelib.errors import MissingExtraError, ParameterError
+from facelib.errors import ParameterError
 from facelib.export.audio import copy_audio
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, export_clip, face_of
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
+from facelib.optional import require
 
 __all__ = ["GltfExport", "export_gltf"]
 
@@ -143,11 +144,7 @@ def _target_name(row: int, scale: float) -> str:
 
 
 def _import_pygltflib() -> Any:
-    try:
-        import pygltflib
-    except ImportError as exc:
-        raise MissingExtraError("glTF export", "export", "pygltflib") from exc
-    return pygltflib
+    return require("pygltflib")
 
 
 def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarray:

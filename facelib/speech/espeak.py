@@ -23,7 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.errors import MissingExtraError, SpeechError
+from facelib.errors import SpeechError
+from facelib.optional import require
 from facelib.speech import espeak_worker
 
 __all__ = ["EspeakEvent", "EspeakVoice", "RawSynthesis", "default_words_per_minute",
@@ -68,10 +69,7 @@ class EspeakVoice:
 
 
 def _check_installed() -> None:
-    try:
-        import espeakng_loader  # noqa: F401
-    except ImportError as exc:
-        raise MissingExtraError("speech synthesis", "speech", "espeakng-loader") from exc
+    require("espeak")
 
 
 def synth_fresh(requests: Sequence[tuple[str, str, int, int]]) -> list[RawSynthesis]:

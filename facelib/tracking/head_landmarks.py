@@ -159,7 +159,7 @@ def detect_head_landmarks(mesh: HeadMesh, *, up: str | None = None,
     up, forward: the mesh's axes ("+x" ... "-z", as for
         :func:`~facelib.engine.setup.headmesh.axes_rotation`) when it is not upright (+y up)
         looking along +z; the mesh is turned upright for the search and the points are given
-        in the mesh's own frame, so they go with the same axes to ``set_up_face(mesh,
+        in the mesh's own frame, so they go with the same axes to ``setup_face(mesh,
         landmarks=found.as_json(), up=up, forward=forward)``. Default: upright.
     feature_points: the ids wanted (default: the default head's feature points); those in
         ``AUTO_EXCLUDED`` and the ones the MediaPipe table does not map are left out.

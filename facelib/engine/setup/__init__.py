@@ -7,6 +7,7 @@ the mesh (:mod:`~facelib.engine.setup.headmesh`), fits the thin-plate spline
 (:mod:`~facelib.engine.setup.eyelids`).
 """
 
-from facelib.engine.setup.fit import UNITS, FaceSetup, read_landmarks, set_up_face, setup_face
+from facelib.engine.setup.fit import UNITS, FaceSetup, read_landmarks, setup_face
+from facelib.engine.setup.fit import set_up_face as set_up_face  # the older name, kept
 
-__all__ = ["UNITS", "FaceSetup", "read_landmarks", "set_up_face", "setup_face"]
+__all__ = ["UNITS", "FaceSetup", "read_landmarks", "setup_face"]
