@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
@@ -17,15 +17,16 @@ from facelib.checks import check_seed
 from facelib.cues import MAX_FRAMES, Storyboard
 from facelib.errors import FacelibError, ParameterError
 from facelib.fdl import load
+from facelib.gaze.animate import GazeAnimation
 from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.progress import ProgressCallback, progress_callback
-from facelib.sync import SyncRules, combine
+from facelib.sync import Liveliness, SyncRules, combine
 from facelib.visemes.animate import SpeechAudio, VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
 
-__all__ = ["Animation", "animate", "definition_line", "run_fdl"]
+__all__ = ["Animation", "animate", "compose", "definition_line", "run_fdl", "speech_track"]
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,7 @@ def animate(
     storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
     max_frames: int = MAX_FRAMES,
     progress: bool | ProgressCallback | None = None,
+    liveliness: Liveliness | None = None,
 ) -> Animation:
     """Run the generators of a storyboard and resolve their conflicts.
 
@@ -86,12 +88,15 @@ def animate(
     :data:`facelib.cues.MAX_FRAMES`); a longer storyboard raises ParameterError before
     anything is computed. ``progress`` (see :mod:`facelib.progress`) is called after each
     of the four stages (speech, expressions, gaze, synchronizer) as ``progress(done, 4)``.
+    ``liveliness`` scales breathing, listening motion, micro-movements and the blink rate
+    (:class:`facelib.sync.Liveliness`; default: the data's numbers).
     An error of a generator that names no file is raised again naming the storyboard (and
     the line of the definition it concerns, where one can be found).
     """
     try:
         return _animate(storyboard, seed=seed, rules=rules, max_frames=max_frames,
-                        report=progress_callback(progress, "animating", unit="stages"))
+                        report=progress_callback(progress, "animating", unit="stages"),
+                        liveliness=liveliness)
     except FacelibError as exc:
         if exc.path is not None or storyboard.path is None:
             raise
@@ -101,7 +106,7 @@ def animate(
 
 def _animate(
     storyboard: Storyboard, *, seed: int | None, rules: SyncRules | None, max_frames: int,
-    report: ProgressCallback | None,
+    report: ProgressCallback | None, liveliness: Liveliness | None,
 ) -> Animation:
     def step(done: int) -> None:
         if report is not None:
@@ -123,33 +128,18 @@ def _animate(
               if storyboard.speech else None)
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
-    speaking = np.zeros(n_frames, bool)
-    viseme_track = FapTrack.empty(n_frames, fps=fps)
-    if speech is not None:
-        viseme_track = _with_importance(speech, rules).padded(n_frames)
-        speaking[: speech.speaking.size] = speech.speaking[:n_frames]
+    viseme_track = None if speech is None else speech_track(speech, rules)
     step(1)
-    expression_track = expressions.animate(
-        storyboard.expressions, fps=fps, n_frames=n_frames,
-        library=expressions.default_library().with_defs(
-            storyboard.expression_defs, mixes=storyboard.expression_mixes
-        ),
-        importance=rules.expression_importance,
-    )
-    step(2)
-    eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
-                        behaviours=storyboard.gaze_defs, speaking=speaking)
-    step(3)
-    stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
-                     blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=speaking,
-                     rules=rules, seed=storyboard.seed)
-    step(4)
+    stream, tracks, eyes = compose(
+        storyboard, visemes=viseme_track,
+        speaking=None if speech is None else speech.speaking, n_frames=n_frames, rules=rules,
+        report=lambda done: step(1 + done), liveliness=liveliness)
     return Animation(
         faps=stream,
         audio=storyboard.speech.audio if storyboard.speech else None,
         storyboard=storyboard,
         audio_offset=storyboard.speech.start_ms / 1000 if storyboard.speech else 0.0,
-        tracks={"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track},
+        tracks=tracks,
         visemes=None if speech is None else speech.timeline,
         gaze_events=eyes.events,
         speech_audio=None if speech is None else speech.audio,
@@ -157,7 +147,53 @@ def _animate(
     )
 
 
-def _with_importance(speech: VisemeAnimation, rules: SyncRules) -> FapTrack:
+def compose(
+    storyboard: Storyboard, *, visemes: FapTrack | None, speaking: np.ndarray | None,
+    n_frames: int, rules: SyncRules, report: Callable[[int], None] | None = None,
+    liveliness: Liveliness | None = None,
+) -> tuple[FapStream, dict[str, FapTrack], GazeAnimation]:
+    """The expressions and the eyes of ``storyboard`` over ``n_frames`` frames, merged with
+    the speech's ``visemes`` track (weights carrying importance, :func:`speech_track`;
+    None: no speech) by the synchronizer: the stream, each generator's track and the eye
+    animation. ``speaking``: ``(k,) bool`` from frame 0 (cut or padded with False to
+    ``n_frames``). Every generator is causal in its random draws, so a longer ``n_frames``
+    or a cue starting at frame ``i`` leaves the frames before ``i`` bit for bit as they
+    were: a live session runs this over a growing window. ``report(k)`` after each of the
+    three stages (expressions, gaze, synchronizer). ``liveliness``: the idle motion's and
+    blink rate's factors (:class:`facelib.sync.Liveliness`; per-frame arrays must have
+    ``n_frames`` rows)."""
+    lively = liveliness or Liveliness()
+    fps = storyboard.fps
+    talking = np.zeros(n_frames, bool)
+    viseme_track = FapTrack.empty(n_frames, fps=fps)
+    if visemes is not None:
+        viseme_track = visemes.padded(n_frames)
+    if speaking is not None:
+        talking[: speaking.size] = speaking[:n_frames]
+    expression_track = expressions.animate(
+        storyboard.expressions, fps=fps, n_frames=n_frames,
+        library=expressions.default_library().with_defs(
+            storyboard.expression_defs, mixes=storyboard.expression_mixes
+        ),
+        importance=rules.expression_importance,
+    )
+    if report is not None:
+        report(1)
+    eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
+                        behaviours=storyboard.gaze_defs, speaking=talking,
+                        blink_rate=lively.blink_rate)
+    if report is not None:
+        report(2)
+    stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
+                     blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=talking,
+                     rules=rules, seed=storyboard.seed, liveliness=lively)
+    if report is not None:
+        report(3)
+    tracks = {"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track}
+    return stream, tracks, eyes
+
+
+def speech_track(speech: VisemeAnimation, rules: SyncRules) -> FapTrack:
     """The viseme track with each viseme's importance (``rules.viseme_importance``) on its
     weight, frame by frame along the timeline."""
     track = speech.track

@@ -23,6 +23,7 @@ __all__ = [
     "check_items",
     "check_kind",
     "check_number",
+    "check_per_frame",
     "check_sample_rate",
     "check_seed",
     "did_you_mean",
@@ -48,6 +49,23 @@ def check_number(name: str, value: object, *, low: float | None = None,
         raise ParameterError(f"{name} must be a finite number in {bracket}{lo}, {hi}], "
                              f"got {value!r}")
     return number
+
+
+def check_per_frame(name: str, value: object, n_frames: int, *, high: float = 100.0
+                    ) -> np.ndarray:
+    """A factor given as one number or one per frame, as a read-only ``(n_frames,) float64``
+    array of finite values in ``[0, high]``; ParameterError otherwise."""
+    if isinstance(value, np.ndarray | list | tuple):
+        array = np.asarray(value, dtype=np.float64)
+        if array.shape != (n_frames,):
+            raise ParameterError(f"{name} must be one number or ({n_frames},) per frame, got "
+                                 f"shape {array.shape}")
+        if not (np.isfinite(array).all() and (array >= 0).all() and (array <= high).all()):
+            raise ParameterError(f"{name} must lie in [0, {high:g}] in every frame")
+    else:
+        array = np.full(n_frames, check_number(name, value, low=0.0, high=high))
+    array.flags.writeable = False
+    return array
 
 
 def check_fps(fps: object) -> float:

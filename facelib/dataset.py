@@ -45,7 +45,6 @@ import numpy as np
 from facelib.atomic import output_folder, write_text_atomic
 from facelib.checks import check_count, check_number, check_seed
 from facelib.errors import FacelibError, ParameterError
-from facelib.optional import missing_extra
 from facelib.progress import ProgressCallback, progress_callback
 
 __all__ = ["ClipDraw", "DatasetReport", "DatasetSpec", "draw_clip", "generate", "load_spec",
@@ -520,31 +519,84 @@ def _star_clip_task(args: tuple[DatasetSpec, int, str]) -> tuple[int, str, str |
 
 
 def _run_dask(spec: DatasetSpec, todo: Sequence[int], out_dir: str, scheduler: Any,
-              report: ProgressCallback | None) -> list[tuple[int, str, str | None]]:
+              report: ProgressCallback | None, *, security: Any,
+              trust: bool) -> list[tuple[int, str, str | None]]:
     """The clips ``todo`` as tasks on a Dask cluster (``scheduler``: an address such as
-    ``tcp://host:8786``, or a ``distributed.Client``); workers write into ``out_dir``,
-    which they must see at the same path (a shared file system)."""
-    try:
-        from distributed import Client, as_completed
-    except ImportError:
-        raise missing_extra("distributed") from None
-    client = scheduler if isinstance(scheduler, Client) else Client(scheduler, timeout=30)
-    try:
-        futures = client.map(_clip_task, [spec] * len(todo), list(todo),
+    ``tcp://host:8786``, or a ``distributed.Client``) through facelib's plain-data client
+    (:func:`facelib.cluster.open_client`); workers write into ``out_dir``, which they must
+    see at the same path (a shared file system), and answer with JSON text."""
+    from facelib.cluster import open_client
+
+    with open_client(scheduler, security=security, trust=trust) as client:
+        from distributed import as_completed
+
+        futures = client.map(_clip_task_text, [spec] * len(todo), list(todo),
                              [out_dir] * len(todo), pure=False)
+        index_of = {future.key: index for future, index in zip(futures, todo, strict=True)}
         results = []
         try:
-            for future in as_completed(futures):
-                results.append(future.result())
+            for future in as_completed(futures, loop=client.loop):
+                results.append(_cluster_result(future, index_of[future.key]))
                 if report is not None:
                     report(len(results), len(todo))
         except BaseException:
             client.cancel(futures)
             raise
         return results
-    finally:
-        if client is not scheduler:
-            client.close()
+
+
+_MAX_RESULT_CHARS = 8192
+"""The longest clip result (JSON text) read from a cluster."""
+_MAX_ERROR_CHARS = 2000
+"""The longest clip error message kept."""
+_STATUSES = ("written", "skipped", "failed")
+
+
+def _clip_task_text(spec: DatasetSpec, index: int, out_dir: str) -> str:
+    """:func:`_clip_task` as the JSON text a cluster sends back: ``{"clip": index,
+    "status": ..., "error": text or null}``."""
+    clip, status, error = _clip_task(spec, index, out_dir)
+    return json.dumps({"clip": clip, "status": status,
+                       "error": None if error is None else error[:_MAX_ERROR_CHARS]})
+
+
+def _cluster_result(future: Any, index: int) -> tuple[int, str, str | None]:
+    """The result of clip ``index``'s task: a failed task (its error is never read) is a
+    failed clip; anything but a valid result text is a FacelibError."""
+    from facelib.cluster import TASK_FAILED
+
+    if future.status == "error":
+        return index, "failed", TASK_FAILED
+    if future.status == "cancelled":
+        return index, "failed", "the task was cancelled on the cluster"
+    return parse_clip_result(future.result(), index)
+
+
+def parse_clip_result(text: object, index: int) -> tuple[int, str, str | None]:
+    """``(index, status, error)`` from the JSON text a worker sent for clip ``index``;
+    refuses (FacelibError) anything else: data facelib's client refused (a pickle), text
+    that is not such JSON, another clip's number, an unknown status."""
+    from facelib.cluster import refused
+    from facelib.fdl.sandbox import one_line
+
+    if refused(text):
+        raise FacelibError(f"clip {index}: the cluster sent {text} instead of the clip's "
+                           f"result (facelib reads only plain data from a cluster)")
+    try:
+        if not isinstance(text, str) or len(text) > _MAX_RESULT_CHARS:
+            raise ValueError(text)
+        row = json.loads(text)
+        clip, status, error = row["clip"], row["status"], row["error"]
+        if (set(row) != {"clip", "status", "error"} or type(clip) is not int
+                or clip != index or status not in _STATUSES
+                or (status == "failed") != isinstance(error, str)
+                or (error is not None and not isinstance(error, str))):
+            raise ValueError(text)
+    except (ValueError, TypeError, KeyError, RecursionError):
+        shown = one_line(text if isinstance(text, str) else repr(text), limit=120)
+        raise FacelibError(f"clip {index}: the cluster's answer is not a clip result: "
+                           f"{shown}") from None
+    return index, status, None if error is None else one_line(error, limit=_MAX_ERROR_CHARS)
 
 
 def _claim(spec: DatasetSpec, out: Path) -> None:
@@ -565,6 +617,17 @@ def _clean_stale(out: Path) -> None:
     """Remove temporary clip folders left by a killed run (``.clip_NNNNNN.*.tmp``)."""
     for stale in out.glob(".clip_*.tmp"):
         shutil.rmtree(stale, ignore_errors=True)
+
+
+def _check_made(out: Path, result: tuple[int, str, str | None]) -> tuple[int, str, str | None]:
+    """``result`` as it was, or failed if it says the clip is made and its folder is not
+    in ``out`` (workers that do not see the dataset folder, or do not tell the truth)."""
+    index, status, _ = result
+    folder = out / CLIP_PATTERN.format(index)
+    if status != "failed" and not folder.is_dir():
+        return index, "failed", (f"reported as made, but {folder} is not there (do the "
+                                 f"workers see this folder at the same path?)")
+    return result
 
 
 def write_index(spec: DatasetSpec, out_dir: str | os.PathLike[str]) -> Path:
@@ -589,13 +652,18 @@ def generate(
     *,
     jobs: int | None = None,
     scheduler: Any = None,
+    security: Any = None,
+    trust_cluster: bool = False,
     progress: bool | ProgressCallback | None = None,
 ) -> DatasetReport:
     """Make every clip of ``spec`` in ``out_dir`` that is not there yet.
 
     Locally with ``jobs`` spawned processes (default: the CPU count), or, given
     ``scheduler`` (a Dask scheduler address or a ``distributed.Client``), as one task per
-    clip on that cluster. ``progress(clips_done, clips_to_make)``. Finished clips are
+    clip on that cluster: a ``tcp://`` scheduler must be on this machine, another one needs
+    ``tls://`` and ``security`` (``facelib.cluster.tls_security``) unless ``trust_cluster``;
+    results come back as plain data only (``docs/security.md``).
+    ``progress(clips_done, clips_to_make)``. Finished clips are
     skipped, so an interrupted run is resumed by running it again. A failing clip is
     reported in the result and the others are made. Writes ``spec.toml`` and, at the end,
     ``index.jsonl``.
@@ -611,10 +679,12 @@ def generate(
     if not todo:
         results: list[tuple[int, str, str | None]] = []
     elif scheduler is not None:
-        results = _run_dask(spec, todo, str(out.resolve()), scheduler, report)
+        results = _run_dask(spec, todo, str(out.resolve()), scheduler, report,
+                            security=security, trust=trust_cluster)
     else:
         n_jobs = default_jobs() if jobs is None else check_count("jobs", jobs, low=1)
         results = _run_local(spec, todo, str(out.resolve()), min(n_jobs, len(todo)), report)
+    results = [_check_made(out, result) for result in results]
     write_index(spec, out)
     failed = tuple(sorted((i, str(e)) for i, status, e in results if status == "failed"))
     written = sum(status == "written" for _, status, _ in results)

@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "facelib"
 BASE = {"errors", "checks", "atomic", "data", "progress", "optional"}
 GENERATORS = {"fdl", "speech", "visemes", "expressions", "gaze"}
 OUTPUTS = {"rendering", "tracking", "export"}
-TOP = {"batch", "dataset", "evaluate", "catalog", "cli", "plot", "__init__", "__main__"}
+TOP = {"batch", "cluster", "dataset", "evaluate", "catalog", "cli", "plot", "__init__", "__main__"}
 
 # unit -> the facelib units it may import (besides itself)
 ALLOWED: dict[str, set[str]] = {
@@ -31,6 +31,8 @@ ALLOWED: dict[str, set[str]] = {
     "engine": BASE | {"mpeg4"},
     "clip": BASE | {"mpeg4", "engine"},
     **{unit: BASE | {"mpeg4", "engine", "clip"} for unit in OUTPUTS},
+    # live sessions: on the layer of animation, plus the outputs they stream (DESIGN.md)
+    "live": BASE | {"mpeg4", "cues", "sync", "animation", "export", "clip"} | GENERATORS,
 }
 ALLOWED["visemes"] = ALLOWED["visemes"] | {"speech"}
 ALLOWED["tracking"] = ALLOWED["tracking"] | {"rendering"}  # landmarks found on a render

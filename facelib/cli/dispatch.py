@@ -32,6 +32,7 @@ from facelib.cli import (
     listing,
     plot,
     render,
+    serve,
     track,
     view,
 )
@@ -53,7 +54,7 @@ from facelib.errors import FacelibError, facelib_warnings
 # The subcommands, each a module with ``add(commands)``, in the order ``--help`` lists them.
 COMMANDS: tuple[ModuleType, ...] = (
     info, check, run_command, render, view, plot, align, listing, dataset, evaluate, track, export,
-    import_arkit, face,
+    import_arkit, face, serve,
 )
 
 

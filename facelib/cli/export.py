@@ -20,6 +20,9 @@ def add(commands: Any) -> None:
                         help="OUT.glb (glTF), or with --arkit OUT.csv (Live Link Face) / OUT.json")
     export.add_argument("--arkit", action="store_true",
                         help="write ARKit-52 blendshape curves instead of glTF")
+    export.add_argument("--targets", choices=("fap", "arkit"), default="fap",
+                        help="glTF morph targets: one per FAP basis vector (fap, the default) or "
+                             "the 52 ARKit-named shapes of the head (arkit)")
     export.add_argument("--html", metavar="DIR", help="also write a web player into DIR")
     export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
     export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
@@ -49,9 +52,10 @@ def _export(args: argparse.Namespace, console: Console) -> int:
             console.status(f"wrote {args.output} ({curves.n_frames} frames of 52 ARKit "
                            f"weights{fit})")
         else:
-            result = export.export_gltf(source, args.output, face=face, audio=args.audio)
+            result = export.export_gltf(source, args.output, face=face, audio=args.audio,
+                                        targets=args.targets)
             audio = f", audio {result.audio}" if result.audio else ""
-            console.status(f"wrote {result.path} ({len(result.targets)} morph targets, "
+            console.status(f"wrote {result.path} ({len(result.names)} morph targets, "
                            f"{result.n_frames} frames{audio})")
     if args.html is not None:
         page = export.export_html(source, args.html, face=face, audio=args.audio)

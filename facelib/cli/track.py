@@ -113,11 +113,11 @@ def _track_source(args: argparse.Namespace, console: Console) -> _Tracked:
                    f"{len(track.lost_frames)}")
     neutral = _neutral(args)
     if neutral is None:
-        first = track.first_lit_face
-        neutral = (first, first + 1)
-        if first:
-            console.status(f"neutral: frame {first}, the first with a well-lit face "
-                           "(--neutral chooses another)")
+        span = track.default_neutral().span
+        neutral = (span.start, span.stop)
+        if span.start:
+            console.status(f"neutral: frames {span.start}-{span.stop - 1} (--neutral "
+                           "chooses others)")
     return _Tracked(track.landmarks, track.info.fps, "mediapipe", neutral, source,
                     video_brows(source, track.landmarks, neutral=neutral))
 

@@ -16,8 +16,16 @@ from typing import Any
 import numpy as np
 
 from facelib import data
+from facelib.engine.attachments import attach, read_attachments
 from facelib.engine.deformers import ALIASES, Deformer, deformer, deformer_names
-from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, RIGID_DEFORMERS, Face, Region
+from facelib.engine.face import (
+    ATTACHED_PARTS,
+    OPTIONAL_PARTS,
+    PART_NAMES,
+    RIGID_DEFORMERS,
+    Face,
+    Region,
+)
 from facelib.engine.meshfile import mesh_path, read_npz
 from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FacelibError, FaceModelError, ParameterError
@@ -57,7 +65,8 @@ Override = str | Deformer | Mapping[str, Any]
 
 
 def load_face(
-    path: str | Path | None = None, *, deformers: Mapping[str, Override] | None = None
+    path: str | Path | None = None, *, deformers: Mapping[str, Override] | None = None,
+    hair: str | None = None,
 ) -> Face:
     """Load a face definition and its mesh, validate them and compile the deformers.
 
@@ -68,6 +77,8 @@ def load_face(
         (``{"lips": "inverse_distance", "brow_l": {"deformer": "rbf", "kernel": "gaussian"}}``);
         a region name wins over its group. A bare name keeps no parameters of the
         definition; give them in the mapping form. Every key must match a region.
+    hair: a hair style of the definition's hair mesh (``"short"``, ``"long"``, ``"tied"``
+        for the default head) instead of the one the definition names; ``"none"``: bald.
 
     Raises
     ------
@@ -95,7 +106,7 @@ def load_face(
     except RecursionError:
         raise FaceModelError("the face definition's JSON is nested too deeply (a face "
                              "definition is a few levels deep)", path=path) from None
-    return _Reader(path, doc, dict(deformers or {})).face()
+    return _Reader(path, doc, dict(deformers or {}), hair).face()
 
 
 def _override(value: Override, key: str) -> tuple[str, Deformer | None, dict[str, Any]]:
@@ -113,8 +124,11 @@ def _override(value: Override, key: str) -> tuple[str, Deformer | None, dict[str
 
 
 class _Reader:
-    def __init__(self, path: Path, doc: Any, overrides: dict[str, Override]):
+    def __init__(self, path: Path, doc: Any, overrides: dict[str, Override],
+                 hair: str | None = None):
         self.path = path
+        self.hair = hair
+        self.hair_uv: np.ndarray | None = None  # the mesh file's hair_uv, if any
         self.doc = doc
         self.overrides = overrides
         self.fields: dict[str, np.ndarray] = {}  # the mesh file's field_* arrays
@@ -145,10 +159,15 @@ class _Reader:
         regions = self.regions(nv, points, pivots)
         neck = self.neck()
         riders = self.riders(parts, nv)
+        pieces = read_attachments(self.path, self.doc, vertices, hair=self.hair)
+        vertices, triangles, colours, ao, extra, uv = attach(
+            vertices, triangles, colours, self.occlusion, pieces)
+        parts.update(extra)
         try:
             return Face.build(vertices=vertices, triangles=triangles, vertex_colors=colours,
                               parts=parts, feature_points=points, regions=regions, pivots=pivots,
-                              neck=neck, vertex_ao=self.occlusion, riders=riders)
+                              neck=neck, vertex_ao=ao, riders=riders,
+                              hair_uv=self.hair_uv if uv is None else uv)
         except FaceModelError as exc:
             raise self.fail(exc.message) from exc
 
@@ -171,6 +190,10 @@ class _Reader:
             raise self.fail(f"vertex_colors must have shape {v.shape}, got {c.shape}")
         c = c / 255.0 if np.issubdtype(c.dtype, np.integer) else c.astype(np.float64)
         self.occlusion = None if occlusion is None else self.occlusion_values(occlusion, len(v))
+        uv = data.get("hair_uv")
+        if uv is not None and (uv.shape != (len(v), 2) or not np.all(np.isfinite(uv))):
+            raise self.fail(f"hair_uv must be finite ({len(v)}, 2), got {uv.shape}")
+        self.hair_uv = None if uv is None else uv.astype(np.float32)
         return v, t, np.clip(c, 0.0, 1.0)
 
     def occlusion_values(self, values: np.ndarray, nv: int) -> np.ndarray:
@@ -201,9 +224,9 @@ class _Reader:
     def parts(self, nv: int) -> dict[str, np.ndarray]:
         raw = self.get("parts", dict)
         out = {}
-        for name in (*PART_NAMES, *OPTIONAL_PARTS):
+        for name in (*PART_NAMES, *OPTIONAL_PARTS, *ATTACHED_PARTS):
             if name not in raw:
-                if name in OPTIONAL_PARTS:
+                if name not in PART_NAMES:
                     continue
                 raise self.fail(f"parts has no {name!r}")
             span = raw[name]
@@ -213,10 +236,10 @@ class _Reader:
                 raise self.fail(f"parts[{name!r}] = {span!r} is not a vertex range [start, stop)"
                                 f" within 0-{nv}")
             out[name] = np.arange(span[0], span[1], dtype=np.int32)
-        unknown = set(raw) - set(PART_NAMES) - set(OPTIONAL_PARTS)
+        unknown = set(raw) - set(PART_NAMES) - set(OPTIONAL_PARTS) - set(ATTACHED_PARTS)
         if unknown:
             raise self.fail(f"unknown part {sorted(unknown)[0]!r}; parts are "
-                            f"{(*PART_NAMES, *OPTIONAL_PARTS)}")
+                            f"{(*PART_NAMES, *OPTIONAL_PARTS, *ATTACHED_PARTS)}")
         return out
 
     def riders(self, parts: dict[str, np.ndarray], nv: int) -> Riders:

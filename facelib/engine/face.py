@@ -42,12 +42,17 @@ from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap, fap_table
 
-__all__ = ["OPTIONAL_PARTS", "PART_NAMES", "Face", "Part", "Region", "Riders"]
+__all__ = ["ATTACHED_PARTS", "OPTIONAL_PARTS", "PART_NAMES", "Face", "Part", "Region", "Riders"]
 
 PART_NAMES = ("skin", "eye_l", "eye_r", "teeth_upper", "teeth_lower", "tongue")
 OPTIONAL_PARTS = ("lashes",)
 """Parts a face may have besides ``PART_NAMES``; their vertices ride on the skin
 (:class:`~facelib.engine.riders.Riders`)."""
+ATTACHED_PARTS = ("bust", "garment", "hair")
+"""Parts a face definition may attach to its head (:mod:`facelib.engine.attachments`): the
+bust's skin and garment fade out of the head's rotation with the neck like the skin; the
+hair turns rigidly with the head (``HEAD_RIGID_PARTS``), wherever it hangs."""
+HEAD_RIGID_PARTS = ("hair",)
 RIGID_DEFORMERS = ("eyelid",)
 """Deformers that are per-frame rigid steps of the face, not entries of the registry."""
 # The rigid steps address FAPs by their names in the standard's table (facelib.mpeg4).
@@ -206,6 +211,9 @@ class Face:
         renderer multiplies into the colours; None where the mesh file has none.
     riders: vertices that move with skin vertices under them (the lashes; see
         :mod:`facelib.engine.riders`); empty for a face without them.
+    hair_uv: (V, 2) float32 hair card coordinates (across the card, root 0 to tip 1) of the
+        ``hair`` part's vertices (zero elsewhere), which the renderer's strand highlight
+        follows; None for a face without hair.
     """
 
     vertices: np.ndarray
@@ -224,6 +232,7 @@ class Face:
     _steps: tuple[_Step, ...] = field(repr=False, default=())
     vertex_ao: np.ndarray | None = field(repr=False, default=None)
     riders: Riders = field(repr=False, default_factory=no_riders)
+    hair_uv: np.ndarray | None = field(repr=False, default=None)
 
     @classmethod
     def build(
@@ -239,6 +248,7 @@ class Face:
         neck: tuple[np.ndarray, np.ndarray, float],
         vertex_ao: np.ndarray | None = None,
         riders: Riders | None = None,
+        hair_uv: np.ndarray | None = None,
     ) -> Face:
         """Compile a face from validated pieces (see :func:`facelib.engine.load_face`).
 
@@ -280,6 +290,7 @@ class Face:
             _steps=steps,
             vertex_ao=None if vertex_ao is None else _readonly(vertex_ao, np.float32),
             riders=riders,
+            hair_uv=None if hair_uv is None else _readonly(hair_uv, np.float32),
         )
 
     def __repr__(self) -> str:
@@ -609,13 +620,16 @@ def _lids(
 
 def _parts(parts: Mapping[str, np.ndarray], tris: np.ndarray, n_vertices: int
            ) -> dict[str, Part]:
-    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it."""
+    """Each part's vertex ids ``(Vp,) int32`` and the triangles ``(Fp, 3)`` all inside it; an
+    attached part (appended after the head) also takes the triangles that join it to the
+    head, those whose last vertex is its own."""
     out = {}
     for name, part_ids in parts.items():
         ids = _readonly(part_ids, np.int32)
         inside = np.zeros(n_vertices, bool)
         inside[ids] = True
-        out[name] = Part(name, ids, _readonly(tris[inside[tris].all(1)], np.int32))
+        mine = inside[tris.max(1)] if name in ATTACHED_PARTS else inside[tris].all(1)
+        out[name] = Part(name, ids, _readonly(tris[mine], np.int32))
     return out
 
 
@@ -629,6 +643,9 @@ def _rigid(verts: np.ndarray, points: Mapping[str, int], fapu: Mapping[str, floa
     height = (verts.astype(np.float64) - point) @ normal
     t = np.clip(height / blend, 0.0, 1.0)
     head_w = t * t * (3 - 2 * t)
+    for name in HEAD_RIGID_PARTS:
+        if name in parts:
+            head_w[parts[name].vertex_ids] = 1.0
     jaw_ids = np.concatenate(
         [parts["teeth_lower"].vertex_ids, parts["tongue"].vertex_ids])
     return _Rigid(

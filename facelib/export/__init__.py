@@ -13,6 +13,7 @@ from facelib.export.arkit import (
     live_link_names,
     to_arkit,
 )
+from facelib.export.arkit_roundtrip import RegionResidual, arkit_residuals
 from facelib.export.gltf import GltfExport, export_gltf
 from facelib.export.livelink import (
     export_arkit,
@@ -25,7 +26,8 @@ from facelib.export.livelink import (
 from facelib.export.web import WebExport, export_html
 
 __all__ = [
-    "ANGLE_NAMES", "ArkitCurves", "GltfExport", "WebExport", "arkit_names", "export_arkit",
+    "ANGLE_NAMES", "ArkitCurves", "GltfExport", "RegionResidual", "WebExport", "arkit_names",
+    "arkit_residuals", "export_arkit",
     "export_gltf", "export_html", "from_arkit", "import_arkit", "live_link_names",
     "read_arkit_json",
     "read_live_link_csv", "to_arkit", "write_arkit_json", "write_live_link_csv",

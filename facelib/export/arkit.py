@@ -132,8 +132,8 @@ def _load_targets(face: Face) -> tuple[np.ndarray, np.ndarray]:
                              " in order: rebuild it with tools/build_arkit_targets.py")
     with data.path("head/default_head.npz").open("rb") as f:
         reference = np.load(f)["vertices"]
-    if face.vertices.shape != reference.shape or not np.allclose(face.vertices, reference,
-                                                                atol=1e-6):
+    own = face.vertices[: len(reference)]  # hair and bust are appended after the head's
+    if own.shape != reference.shape or not np.allclose(own, reference, atol=1e-6):
         raise FaceModelError("ARKit curves need the default head (its ARKit targets come from "
                              "the same base mesh); this face has other vertices")
     ids = np.unique(raw["vertices"])
@@ -277,16 +277,33 @@ def to_arkit(source: Source, *, face: Face | None = None) -> ArkitCurves:
     return ArkitCurves(float(stream.fps), weights, angles, residual, relative)
 
 
+@cache
+def _correction() -> np.ndarray:
+    """``(52, 84) float64``: the learned part of the import (``export/arkit_correction.npz``,
+    built by ``tools/build_arkit_correction.py``)."""
+    with data.path("export/arkit_correction.npz").open("rb") as f:
+        correction = np.asarray(np.load(f)["correction"], np.float64)
+    if correction.shape != (len(arkit_names()), N_FAPS):
+        raise FaceModelError("export/arkit_correction.npz has the wrong shape: rebuild it with "
+                             "tools/build_arkit_correction.py")
+    return correction
+
+
 def from_arkit(curves: ArkitCurves, *, face: Face | None = None) -> FapStream:
     """A FapStream that plays ARKit curves on ``face`` (default: the bundled head).
 
-    The blendshapes become low-level FAPs 3-68 through the face's least-squares map; head
-    and eye angles become FAPs 48-50 and 23-26. Values are FAP units (float).
+    The blendshapes become low-level FAPs 3-68: the face's least-squares map (the FAPs whose
+    deformation best matches the weighted ARKit targets) plus a learned linear correction
+    (``export/arkit_correction.npz``: what that map misses of facelib's own animations,
+    mostly the lip FAPs, whose motion lies largely outside the ARKit shapes; see
+    ``tools/build_arkit_correction.py``). Head and eye angles become FAPs 48-50 and 23-26.
+    Values are FAP units (float).
     """
     if not isinstance(curves, ArkitCurves):
         raise ParameterError(f"from_arkit() takes ArkitCurves, not {type(curves).__name__}")
     face, basis = _basis(face)
-    values = (curves.weights.astype(np.float64) @ basis.to_faps.T).astype(np.float32)
+    weights = curves.weights.astype(np.float64)
+    values = (weights @ basis.to_faps.T + weights @ _correction()).astype(np.float32)
     au = face.fapu["AU"]
     for k, j in enumerate(_ANGLE_FAPS):
         if j:

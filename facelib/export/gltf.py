@@ -24,6 +24,7 @@ from facelib.errors import ParameterError
 from facelib.export.audio import copy_audio
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, export_clip, face_of
+from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
 from facelib.optional import require
@@ -44,7 +45,10 @@ class GltfExport:
         signs has two targets, one per sign); scales: (T,) float32 the FAP value at which
         each target's weight is 1 (the stream's largest value of that sign: negative for the
         negative target). Every animated weight is in [0, 1] (Blender clamps to that).
+        With ``targets="arkit"``: ``targets`` is empty and ``scales`` all ones (52).
     n_frames, fps: the animation's frames (one keyframe per frame) and rate.
+    names: (T,) each target's name (``mesh.extras.targetNames``): ``fap4_lower_t_midlip``,
+        ``fap4_lower_t_midlip_neg`` ..., or the 52 ARKit names ``eyeBlinkLeft`` ...
     """
 
     path: Path
@@ -53,6 +57,7 @@ class GltfExport:
     scales: np.ndarray
     n_frames: int
     fps: float
+    names: tuple[str, ...] = ()
 
 
 class _Builder:
@@ -98,8 +103,10 @@ class _Builder:
                     bufferView=self.view(ids.astype(index_type)),
                     componentType=_USHORT if index_type is np.uint16 else _UINT),
                 values=lib.AccessorSparseValues(bufferView=self.view(values.astype(np.float32))))
-            lo = np.minimum(values.min(0), 0).tolist()
-            hi = np.maximum(values.max(0), 0).tolist()
+            lo, hi = values.min(0), values.max(0)
+            if len(ids) < count:  # the other elements are zeros
+                lo, hi = np.minimum(lo, 0), np.maximum(hi, 0)
+            lo, hi = lo.astype(np.float32).tolist(), hi.astype(np.float32).tolist()
         extra = {"min": lo, "max": hi} if bounds else {}
         self.g.accessors.append(lib.Accessor(
             byteOffset=None, componentType=_FLOAT, count=count, type="VEC3", sparse=sparse,
@@ -258,17 +265,65 @@ def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: P
     b.g.animations.append(animation)
 
 
-def _asset_extras(stream: FapStream, rows: np.ndarray, scales: np.ndarray,
-                  copied: Path | None, offset: float) -> dict[str, Any]:
+def _asset_extras(stream: FapStream, targets: dict[str, Any], copied: Path | None,
+                  offset: float) -> dict[str, Any]:
     """``asset.extras``: facelib's frame rate, frame count, audio and targets."""
     return {"facelib": {
         "fps": float(stream.fps), "n_frames": int(stream.n_frames),
         "audio": copied.name if copied else None, "audio_offset": float(offset),
-        "targets": [{"fap": int(r) + 1, "name": fap(int(r) + 1).name, "scale": float(s)}
-                    for r, s in zip(rows, scales, strict=True)],
-        "_targets": "each target is a FAP's displacement at FAP value scale; a FAP with values "
-                    "of both signs has one target per sign, so every weight is in [0, 1]",
-        "joint_fractions": FRACTIONS}}
+        **targets, "joint_fractions": FRACTIONS}}
+
+
+@dataclass(frozen=True, eq=False)
+class _Targets:
+    """What the morph targets and the animation hold: names (T,), displacements (T, V, 3)
+    float32, weights (n, T) float32 in [0, 1], the pose, and the asset extras' entry."""
+
+    names: tuple[str, ...]
+    displacements: np.ndarray
+    weights: np.ndarray
+    pose: Pose
+    rows: np.ndarray
+    scales: np.ndarray
+    extras: dict[str, Any]
+
+
+def _fap_targets(face: Face, rig: Rig, stream: FapStream) -> _Targets:
+    """One target per basis vector the stream uses, one per sign (:func:`signed_targets`)."""
+    rows, scales, weights = signed_targets(*morph_weights(face, stream))
+    dense = face.operator[rows].toarray().reshape(len(rows), face.n_vertices, 3)
+    names = tuple(_target_name(int(r), float(s)) for r, s in zip(rows, scales, strict=True))
+    extras = {"targets": [{"fap": int(r) + 1, "name": fap(int(r) + 1).name, "scale": float(s)}
+                          for r, s in zip(rows, scales, strict=True)],
+              "_targets": "each target is a FAP's displacement at FAP value scale; a FAP with "
+                          "values of both signs has one target per sign, so every weight is in "
+                          "[0, 1]"}
+    return _Targets(names, (dense * scales[:, None, None]).astype(np.float32), weights,
+                    pose_rig(face, rig, stream), rows, scales, extras)
+
+
+def _arkit_targets(face: Face, rig: Rig, stream: FapStream) -> _Targets:
+    """The 52 ARKit shapes (:mod:`facelib.export.arkit_targets`) weighted by
+    :func:`facelib.export.to_arkit`'s curves; only the head turns by joints."""
+    from facelib.export.arkit import to_arkit
+    from facelib.export.arkit_targets import arkit_shape_targets, arkit_target_names
+
+    curves = to_arkit(stream)  # FAP units: the default head's fit plays on any face
+    head_only = np.zeros_like(stream.values)
+    head = [fap(k).index for k in ("head_pitch", "head_yaw", "head_roll")]
+    head_only[:, head] = apply_high_level(stream).values[:, head]
+    pose = pose_rig(face, rig, FapStream(stream.fps, head_only))
+    extras = {"targets": "arkit",
+              "_targets": "the 52 ARKit blendshapes (ARKit's names); each target is the face "
+                          "deformed by the shape's FAP recipe, the weights are facelib's ARKit "
+                          "curves of the stream (export_arkit)",
+              "arkit_residual_rms_m": float(np.mean(curves.residual))}
+    n = len(arkit_target_names())
+    return _Targets(arkit_target_names(), arkit_shape_targets(face), curves.weights, pose,
+                    np.zeros(0, np.int64), np.ones(n, np.float32), extras)
+
+
+_TARGET_KINDS = {"fap": _fap_targets, "arkit": _arkit_targets}
 
 
 def export_gltf(
@@ -277,6 +332,7 @@ def export_gltf(
     *,
     face: Face | None = None,
     audio: str | os.PathLike[str] | None = None,
+    targets: str = "fap",
 ) -> GltfExport:
     """Write a binary glTF (``.glb``) of ``source`` played on ``face``.
 
@@ -291,38 +347,48 @@ def export_gltf(
         format its content shows (``a.glb`` -> ``a.wav``); ParameterError if it shows none.
         glTF has no audio: the copy is named in ``asset.extras.facelib.audio``, its start in
         ``audio_offset`` (seconds).
+    targets: ``"fap"`` (one target per FAP basis vector the stream uses, per sign; eyes,
+        lids, jaw and head by joints; plays ``Face.deform`` exactly) or ``"arkit"`` (the 52
+        ARKit-named targets of the face, weighted by the stream's ARKit curves; only the
+        head by joints; plays what the ARKit round trip plays).
     """
     lib = _import_pygltflib()
     out = Path(out)
     if out.suffix.lower() != ".glb":
         raise ParameterError(f"export_gltf writes binary glTF: give a .glb path, not {out}")
+    if targets not in _TARGET_KINDS:
+        raise ParameterError(f"targets must be one of {sorted(_TARGET_KINDS)}, not {targets!r}")
     clip = export_clip(source, face=face, audio=audio)
-    stream, audio_path, offset = clip.stream, clip.audio, clip.audio_offset
+    stream = clip.stream
     face = face_of(clip) or default_face()
     rig = build_rig(face)
-    pose = pose_rig(face, rig, stream)
-    rows, scales, weights = signed_targets(*morph_weights(face, stream))
-    dense = face.operator[rows].toarray().reshape(len(rows), face.n_vertices, 3)
-    targets = (dense * scales[:, None, None]).astype(np.float32)
-    copied = copy_audio(audio_path, out)
+    made = _TARGET_KINDS[targets](face, rig, stream)
+    copied = copy_audio(clip.audio, out)
+    with atomic_path(out) as temp:
+        temp.write_bytes(_container(lib, face, rig, made, stream, copied=copied,
+                                    offset=clip.audio_offset))
+    return GltfExport(out, copied, tuple(int(r) + 1 for r in made.rows), made.scales,
+                      int(stream.n_frames), float(stream.fps), made.names)
+
+
+def _container(lib: Any, face: Face, rig: Rig, made: _Targets, stream: FapStream, *,
+               copied: Path | None, offset: float) -> bytes:
+    """The ``.glb`` bytes: the mesh with its targets, the skin and the animation."""
     g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
-    g.asset.extras = _asset_extras(stream, rows, scales, copied, offset)
+    g.asset.extras = _asset_extras(stream, made.extras, copied, offset)
     b = _Builder(g, lib)
-    mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, targets),
-                    weights=[0.0] * len(rows) if len(rows) else None)
-    if len(rows):
-        mesh.extras = {"targetNames": [_target_name(int(r), float(s))
-                                       for r, s in zip(rows, scales, strict=True)]}
+    count = len(made.names)
+    mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, made.displacements),
+                    weights=[0.0] * count if count else None)
+    if count:
+        mesh.extras = {"targetNames": list(made.names)}
     g.meshes.append(mesh)
     g.nodes.append(lib.Node(name="face", mesh=0, skin=0))
-    joint_nodes = _skeleton(b, rig, pose)
+    joint_nodes = _skeleton(b, rig, made.pose)
     g.scenes.append(lib.Scene(name="facelib", nodes=[0, joint_nodes[0]]))
     g.scene = 0
-    _animation(b, joint_nodes, weights, pose, fps=float(stream.fps))
+    _animation(b, joint_nodes, made.weights, made.pose, fps=float(stream.fps))
     blob = b.blob()
     g.buffers.append(lib.Buffer(byteLength=len(blob)))
     g.set_binary_blob(blob)
-    with atomic_path(out) as temp:
-        temp.write_bytes(b"".join(g.save_to_bytes()))
-    return GltfExport(out, copied, tuple(int(r) + 1 for r in rows), scales,
-                      int(stream.n_frames), float(stream.fps))
+    return b"".join(g.save_to_bytes())

@@ -110,6 +110,7 @@ def animate(
     seed: int,
     behaviours: Mapping[str, Mapping[str, Any]] | None = None,
     speaking: np.ndarray | None = None,
+    blink_rate: float = 1.0,
 ) -> GazeAnimation:
     """Eye, lid and eye-driven head animation for ``n_frames`` frames at ``fps``.
 
@@ -122,6 +123,8 @@ def animate(
     behaviours: storyboard-defined or overridden behaviours, merged over the library.
     speaking: (n_frames,) bool, True where the character talks; behaviours in mode
         ``auto`` use talking statistics there and listening elsewhere (all listening if None).
+    blink_rate: factor on every state's spontaneous blink rate (``alive/blinks.json``),
+        e.g. from a mood; the least blink interval holds whatever the factor.
 
     Raises
     ------
@@ -129,6 +132,7 @@ def animate(
     ParameterError: bad fps, n_frames or speaking.
     """
     fps, n_frames, seed = _checked(fps, n_frames, seed)
+    blink_rate = check_number("blink_rate", blink_rate, low=0.0, high=100.0)
     cues = check_items("cues", cues, GazeCue)
     library = merge_behaviours(behaviours)
     bound = [
@@ -138,7 +142,7 @@ def animate(
     default = bind_behaviour("default", (), library=library)
     seconds = n_frames / fps
     gaze_rng, blink_rng, fixation_rng = np.random.default_rng(seed).spawn(3)
-    planner = Planner(gaze_rng, _mode_lookup(speaking, fps, n_frames))
+    planner = Planner(gaze_rng, _mode_lookup(speaking, fps, n_frames), blink_rate=blink_rate)
 
     segments = _segments(bound, default, seconds)
     for t0, t1, behaviour in segments:
@@ -264,17 +268,20 @@ def simulate(
     seed: int = 0,
     behaviours: Mapping[str, Mapping[str, Any]] | None = None,
     speaking: bool = False,
+    blink_rate: float = 1.0,
 ) -> GazeAnimation:
     """Run one behaviour for ``seconds`` as an eye-script tuple would, e.g.
     ``simulate("default", "talking", 0.9, seconds=600)``. ``speaking`` says whether the
-    character talks throughout (for mode ``auto``)."""
+    character talks throughout (for mode ``auto``); ``blink_rate`` scales the blink rate
+    (see :func:`animate`)."""
     seconds = check_number("seconds", seconds, low=0.0, low_open=True)
     fps = check_fps(fps)
     n_frames = round(seconds * fps)
     cue = GazeCue(behaviour, tuple(args), 0, round(seconds * 1000))
     talk = np.full(n_frames, bool(speaking))
     return animate(
-        [cue], fps=fps, n_frames=n_frames, seed=seed, behaviours=behaviours, speaking=talk
+        [cue], fps=fps, n_frames=n_frames, seed=seed, behaviours=behaviours, speaking=talk,
+        blink_rate=blink_rate,
     )
 
 

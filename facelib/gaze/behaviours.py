@@ -18,6 +18,7 @@ from facelib import data
 from facelib.checks import did_you_mean
 from facelib.errors import FdlError
 from facelib.gaze.model import GAZE_MODES, mode_stats
+from facelib.gaze.norms import BLINK_STATES, head_eye_rule
 
 __all__ = [
     "DIRECTION_NAMES",
@@ -40,7 +41,7 @@ _NUMERIC = (
     "head_threshold_deg",
 )
 _PAIRS = ("gaze_offset_deg", "head_offset_deg")
-PARAM_KEYS = ("engine", "mode", "direction_percent", *_NUMERIC, *_PAIRS)
+PARAM_KEYS = ("engine", "mode", "blink_state", "direction_percent", *_NUMERIC, *_PAIRS)
 _SLOTS = ("p_away", "intensity", "direction", "angle", "head")
 _BEHAVIOUR_KEYS = ("description", "args", "params", "base")
 
@@ -148,7 +149,10 @@ def _validate_param(name: str, key: str, value: Any) -> None:
     if key not in PARAM_KEYS:
         raise FdlError(f"{where}: unknown parameter {key!r}" + _suggest(key, PARAM_KEYS))
     if value is None and key not in ("engine", "mode"):
-        return  # None: the mode's own value
+        return  # None: the mode's own value (or the head-eye rule's, the mode's blink state)
+    if key == "blink_state" and value not in BLINK_STATES:
+        raise FdlError(f"{where}: blink_state {value!r:.40}"
+                       + _suggest(str(value), BLINK_STATES))
     if key in _NUMERIC and not _in_limits(key, value):
         low, high = _limits()[key]
         raise FdlError(f"{where}: {key} must be a number in [{low:g}, {high:g}], got "
@@ -209,8 +213,10 @@ class BoundBehaviour:
     mode: talking/listening/thinking, or ``"auto"`` (from where the character speaks).
     direction_percent: (8,) bin weights or None (the mode's table).
     magnitude_scale, magnitude_max_deg (None = mode's), p_mutual (None = mode's),
-    interval_scale, lid_closure, blink_scale, head_coupling, head_threshold_deg: see the
-    data file. gaze_offset_deg, head_offset_deg: (left, up) degrees.
+    interval_scale, lid_closure, blink_scale: see the data file. head_coupling,
+    head_threshold_deg: the slope and onset of the head's share of a gaze shift (None = the
+    rule of ``alive/head_eye.json``). blink_state: the blink state (None = the mode's).
+    gaze_offset_deg, head_offset_deg: (left, up) degrees.
     intensity: blend factor toward ``default`` already applied to the numbers above.
     target_deg: (left, up) of a look/pursuit target relative to the current gaze origin;
     head: True if a look/pursuit moves the head.
@@ -228,8 +234,9 @@ class BoundBehaviour:
     head_offset_deg: tuple[float, float]
     lid_closure: float
     blink_scale: float
-    head_coupling: float
-    head_threshold_deg: float
+    head_coupling: float | None
+    head_threshold_deg: float | None
+    blink_state: str | None = None
     target_deg: tuple[float, float] = (0.0, 0.0)
     head: bool = False
 
@@ -351,8 +358,9 @@ def _bound(name: str, params: Mapping[str, Any], slots: Mapping[str, Any]) -> Bo
         head_offset_deg=(float(head_offset[0]), float(head_offset[1])),
         lid_closure=float(params["lid_closure"]),
         blink_scale=float(params["blink_scale"]),
-        head_coupling=float(params["head_coupling"]),
-        head_threshold_deg=float(params["head_threshold_deg"]),
+        head_coupling=_optional_float(params["head_coupling"]),
+        head_threshold_deg=_optional_float(params["head_threshold_deg"]),
+        blink_state=params.get("blink_state"),
         target_deg=target,
         head=bool(slots.get("head", False)),
     )
@@ -368,6 +376,8 @@ def _blend(
         "p_mutual": stats.p_mutual,
         "magnitude_max_deg": stats.magnitude_max_deg,
         "direction_percent": list(stats.direction_percent),
+        "head_coupling": head_eye_rule().slope,
+        "head_threshold_deg": head_eye_rule().onset_deg,
     }
     out = dict(params)
     for key in (*_NUMERIC, "direction_percent", *_PAIRS):

@@ -1,5 +1,6 @@
-"""Blinks: when they happen (spontaneous rate by mode, gaze-evoked on large shifts) and the
-lid closure curve (fast close, short closed phase, slower open).
+"""Blinks: when they happen (spontaneous rate by state, never closer than the least interval,
+gaze-evoked on large shifts; ``alive/blinks.json``) and the lid closure curve (fast close,
+short closed phase, slower open).
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import numpy as np
 
 from facelib.gaze.events import Blink
 from facelib.gaze.model import gaze_model
+from facelib.gaze.norms import blink_norms
 
 __all__ = ["blink_closure", "blink_duration", "schedule_blinks"]
 
@@ -29,15 +31,17 @@ def schedule_blinks(
 ) -> list[Blink]:
     """Blink times over ``[0, seconds)``.
 
-    Spontaneous blinks form a renewal process: each interval is the refractory time plus a
-    gamma variable, with mean ``60 / rate`` (rate read from ``rate_per_min(t)`` at the
-    previous blink, so it follows changes of mode) and the model's coefficient of variation.
-    ``evoked_at`` are onsets of gaze shifts that trigger a blink (already thinned by the
-    evoked probability); such a blink replaces the spontaneous process's pending blink when
-    it comes first and restarts the interval from it.
+    Spontaneous blinks form a renewal process: each interval is the least blink interval
+    (``min_interval_s`` of ``alive/blinks.json``) plus a gamma variable, with mean
+    ``60 / rate`` (rate read from ``rate_per_min(t)`` at the previous blink, so it follows
+    changes of state) and the norms' coefficient of variation. ``evoked_at`` are onsets of
+    gaze shifts that carry a blink (already thinned by the evoked probability): such a blink
+    takes the place of the pending spontaneous one when it comes first, and the blink after
+    keeps its time, so the rate stays the measured one; one within the least interval of
+    the blink before is dropped. No two onsets are closer than the least interval.
     """
-    b = gaze_model()["blink"]
-    cv, refractory = float(b["interval_cv"]), float(b["refractory_s"])
+    norms = blink_norms()
+    cv, least = norms.interval_cv, norms.min_interval_s
     evoked = sorted(evoked_at)
     blinks: list[Blink] = []
     duration = blink_duration()
@@ -46,28 +50,26 @@ def schedule_blinks(
         rate = rate_per_min(t)
         if rate <= 0:
             return np.inf
-        excess = max(60.0 / rate - refractory, 1e-3)
-        sd = cv * 60.0 / rate
-        shape = (excess / sd) ** 2
-        return refractory + float(rng.gamma(shape, excess / shape))
+        mean = 60.0 / rate
+        excess = max(mean - least, 1e-3)
+        shape = (excess / max(cv * mean, 1e-9)) ** 2
+        return least + float(rng.gamma(shape, excess / shape))
 
     # The first blink comes after a uniform fraction of an interval (stationary start).
-    t_next = draw(0.0) * float(rng.random())
+    pending = draw(0.0) * float(rng.random())
     i = 0
     last = -np.inf
     while True:
-        while i < len(evoked) and evoked[i] < last + refractory:
+        while i < len(evoked) and evoked[i] < last + least:
             i += 1
-        if i < len(evoked) and evoked[i] <= t_next:
-            t, is_evoked = evoked[i], True
-            i += 1
-        else:
-            t, is_evoked = t_next, False
+        is_evoked = i < len(evoked) and evoked[i] <= pending
+        t = evoked[i] if is_evoked else pending
+        i += int(is_evoked)
         if t >= seconds:
             break
-        blinks.append(Blink(start=float(t), duration=duration, evoked=is_evoked))
+        blinks.append(Blink(start=float(t), duration=duration, evoked=bool(is_evoked)))
         last = t
-        t_next = t + draw(t)
+        pending += draw(pending)
     return blinks
 
 

@@ -6,8 +6,9 @@ The parameters and their sources are the ``fixation`` block of
 Poisson process with a refractory time whose steps aim back at the fixation point, each a
 short linear ramp. The offset is clamped to a disk of ``max_deg`` and scaled by a hold
 envelope that is 0 during a saccade and fades in once the eyes have held still a moment, so
-only long gaze holds show it. Every draw comes from the caller's generator: the same seed
-gives the same offsets bit for bit.
+only long gaze holds show it. Every draw comes from the caller's generator (split into one
+per process: drift, onsets, steps): the same seed gives the same offsets bit for bit, and a
+longer clip the same offsets over its start.
 """
 
 from __future__ import annotations
@@ -60,8 +61,9 @@ def _drift(rng: np.random.Generator, n: int, dt: float) -> np.ndarray:
     k, diffusion = float(p["drift_return_per_s"]), float(p["drift_diffusion_deg2_s"])
     a = np.exp(-k * dt)
     spread = np.sqrt(diffusion / k)  # stationary sd per axis
+    start = rng.standard_normal(2) * spread
     noise = rng.standard_normal((n, 2)) * spread * np.sqrt(1.0 - a * a)
-    noise[0] = rng.standard_normal(2) * spread
+    noise[0] = start
     return _recursive(noise, float(a))
 
 
@@ -106,8 +108,10 @@ def fixational_motion(rng: np.random.Generator, times: np.ndarray, *,
     if n == 0:
         return Fixational(np.zeros((0, 2)), np.zeros(0))
     dt = float(times[1] - times[0]) if n > 1 else 1.0
-    drift = _drift(rng, n, dt)
-    onsets = _onsets(rng, float(times[-1]) + dt)
+    # each process draws from its own generator, so a longer clip keeps its start
+    drift_rng, onset_rng, rng = rng.spawn(3)
+    drift = _drift(drift_rng, n, dt)
+    onsets = _onsets(onset_rng, float(times[-1]) + dt)
     low, high = (float(v) for v in p["amplitude_deg"])
     duration, spread = float(p["duration_s"]), np.radians(float(p["aim_sd_deg"]))
     jumps, partial, done = np.zeros((n + 1, 2)), np.zeros((n, 2)), np.zeros(2)

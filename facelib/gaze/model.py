@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from facelib import data
+from facelib.gaze.norms import blink_norms
 
 __all__ = [
     "GAZE_MODES",
@@ -46,7 +47,8 @@ class ModeStats:
     p_mutual: probability that the next gaze state is mutual gaze.
     mutual_s, away_s: (mean, sd) of the state durations in seconds.
     magnitude_max_deg: largest saccade drawn.
-    blinks_per_min: spontaneous blink rate.
+    blinks_per_min: spontaneous blink rate of the mode's blink state
+        (``alive/blinks.json``).
     direction_percent: (8,) percentages of the direction bins 0, 45, ..., 315 degrees.
     """
 
@@ -64,6 +66,7 @@ def mode_stats(mode: str) -> ModeStats:
     model = gaze_model()
     modes = model["modes"]
     row = modes[mode]
+    norms = blink_norms()
     fps = float(modes["frames_per_second"])
     percent = row.get("direction_percent", model["saccade"]["direction_percent"])
     return ModeStats(
@@ -71,7 +74,7 @@ def mode_stats(mode: str) -> ModeStats:
         mutual_s=(row["mutual_frames"][0] / fps, row["mutual_frames"][1] / fps),
         away_s=(row["away_frames"][0] / fps, row["away_frames"][1] / fps),
         magnitude_max_deg=float(row["magnitude_max_deg"]),
-        blinks_per_min=float(row["blinks_per_min"]),
+        blinks_per_min=norms.rate(norms.mode_state[mode]),
         direction_percent=tuple(float(p) for p in percent),
     )
 

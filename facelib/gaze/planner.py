@@ -21,6 +21,7 @@ from facelib.gaze.model import (
     sample_magnitude,
 )
 from facelib.gaze.motion import Motion, Movement
+from facelib.gaze.norms import blink_norms, head_eye_rule
 from facelib.gaze.pursuit import pursue_path
 
 __all__ = ["Planner"]
@@ -48,12 +49,15 @@ class Planner:
     ``mode_at(t)`` says ``"talking"`` or ``"listening"`` for behaviours in mode ``auto``.
     """
 
-    def __init__(self, rng: np.random.Generator, mode_at: Callable[[float], str]) -> None:
+    def __init__(self, rng: np.random.Generator, mode_at: Callable[[float], str], *,
+                 blink_rate: float = 1.0) -> None:
         self.rng = rng
+        self.blink_rate_scale = float(blink_rate)
+        self.norms = blink_norms()
+        self.head_eye = head_eye_rule()
         self.mode_at = mode_at
         model = gaze_model()
         self.head_cfg = model["head"]
-        self.blink_cfg = model["blink"]
         self.spread = float(model["mutual_spread_deg"])
         lim = model["eye_limits_deg"]
         self.eye_lo = np.array([-lim["yaw"], -lim["down"]], dtype=float)
@@ -69,7 +73,8 @@ class Planner:
         self.saccades: list[Saccade] = []
         self.head_moves: list[HeadMove] = []
         self.evoked: list[float] = []
-        self.rate_segments: list[tuple[float, str, float]] = []  # start, mode, scale
+        self.rate_segments: list[tuple[float, str, float, str | None]] = []  # start, mode,
+        # scale, blink state (None: the mode's)
         self._lid_value = 0.0
 
     # -- shared pieces -------------------------------------------------------------------
@@ -77,25 +82,25 @@ class Planner:
         return self.mode_at(t) if behaviour.mode == "auto" else behaviour.mode
 
     def blink_rate(self, t: float) -> float:
-        """Spontaneous blinks per minute at time ``t``."""
-        starts = [s for s, _, _ in self.rate_segments]
+        """Spontaneous blinks per minute at time ``t``: the rate of the segment's blink state
+        (or its mode's) times the behaviour's ``blink_scale`` and the planner's
+        ``blink_rate``."""
+        starts = [s for s, _, _, _ in self.rate_segments]
         k = int(np.searchsorted(starts, t, side="right")) - 1
         if k < 0:
-            return mode_stats(self.mode_at(t)).blinks_per_min
-        _, mode, scale = self.rate_segments[k]
+            return mode_stats(self.mode_at(t)).blinks_per_min * self.blink_rate_scale
+        _, mode, scale, state = self.rate_segments[k]
         mode = self.mode_at(t) if mode == "auto" else mode
-        return mode_stats(mode).blinks_per_min * scale
+        rate = self.norms.rate(state) if state is not None else mode_stats(mode).blinks_per_min
+        return rate * scale * self.blink_rate_scale
 
     def _head_for(self, gaze: np.ndarray, behaviour: BoundBehaviour) -> np.ndarray:
-        """Head orientation a statistical gaze target recruits: the share ``head_coupling``
-        of the part of the shift beyond ``head_threshold_deg`` (from the head's offset)."""
+        """Head orientation a gaze target recruits: the head-eye rule (``alive/head_eye.json``,
+        or the behaviour's ``head_coupling`` beyond ``head_threshold_deg``) applied to the
+        shift from the behaviour's head offset."""
         base = np.asarray(behaviour.head_offset_deg, dtype=float)
-        rel = gaze - base
-        size = float(np.hypot(*rel))
-        excess = size - behaviour.head_threshold_deg
-        if excess <= 0 or size == 0:
-            return base
-        return base + behaviour.head_coupling * excess * rel / size
+        return base + self.head_eye.head_for(gaze - base, onset_deg=behaviour.head_threshold_deg,
+                                             slope=behaviour.head_coupling)
 
     def shift(self, t: float, gaze: np.ndarray, head: np.ndarray | None, kind: SaccadeKind) -> None:
         """A saccade at ``t`` to gaze ``gaze``, moving the head to ``head`` (None: keep)."""
@@ -117,10 +122,8 @@ class Planner:
         self.gaze.add(Movement(t, duration, (float(gaze[0]), float(gaze[1])), "saccade"))
         self.saccades.append(Saccade(t, duration, magnitude, direction, head_amp, kind))
         self.gaze_target = gaze
-        cfg = self.blink_cfg
-        if magnitude >= float(cfg["evoked_threshold_deg"]) and self.rng.random() < float(
-            cfg["evoked_probability"]
-        ):
+        p_blink = self.norms.evoked_probability(magnitude)
+        if p_blink > 0 and self.rng.random() < p_blink:
             self.evoked.append(t)
 
     def begin(self, t: float, behaviour: BoundBehaviour, *, blink_scale: float = 1.0) -> None:
@@ -129,7 +132,7 @@ class Planner:
             ramp = float(gaze_model()["lids"]["aperture_ramp_s"])
             self.lid.add(Movement(t, ramp, (behaviour.lid_closure, 0.0), "minjerk"))
             self._lid_value = behaviour.lid_closure
-        self.rate_segments.append((t, behaviour.mode, blink_scale))
+        self.rate_segments.append((t, behaviour.mode, blink_scale, behaviour.blink_state))
 
     # -- engines -------------------------------------------------------------------------
     def statistical(self, t0: float, t1: float, b: BoundBehaviour) -> None:
@@ -186,11 +189,15 @@ class Planner:
         return centre + amp * unit
 
     def look(self, t0: float, t1: float, b: BoundBehaviour) -> None:
-        """``lookTo``: one shift to the target, held until ``t1``; with ``head`` the head
-        takes ``look_share`` of the angle, without it the head stays where it is."""
-        self.begin(t0, b)
+        """``lookTo``: one shift to the target, held until ``t1``. The head takes its share
+        by the head-eye rule (:meth:`_head_for`); with ``head`` it turns at least
+        ``look_share`` of the angle toward the target."""
+        self.begin(t0, b, blink_scale=b.blink_scale)
         target = np.asarray(b.target_deg, dtype=float)
-        head = target * float(self.head_cfg["look_share"]) if b.head else None
+        head = self._head_for(target, b)
+        if b.head:
+            toward = target * float(self.head_cfg["look_share"])
+            head = toward if np.hypot(*toward) > np.hypot(*head) else head
         self.shift(t0, target, head, "look")
 
     def pursuit(self, t0: float, t1: float, b: BoundBehaviour) -> None:

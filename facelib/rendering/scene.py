@@ -117,7 +117,8 @@ def framing_points(face: Any, name: str, *, look: Look | None = None) -> np.ndar
     """``(K, 3) float32`` points whose bounding box the camera frames for framing ``name``.
 
     ``face`` needs ``vertices``; ``"face"`` also needs ``feature_points`` (id -> vertex) with
-    the look's points, and falls back to the whole mesh (``"head"``) when it lacks them.
+    the look's points, and falls back to the whole mesh (``"head"``) when it lacks them; a
+    framing's ``exclude_parts`` leaves those parts of ``face.parts`` out of the box.
     """
     look = look or load_look()
     if name not in look.framings:
@@ -129,6 +130,12 @@ def framing_points(face: Any, name: str, *, look: Look | None = None) -> np.ndar
     wanted = spec.get("feature_points", [])
     if spec.get("all_vertices") or not all(k in fps for k in wanted):
         box = vertices
+        parts = getattr(face, "parts", {}) or {}
+        left_out = [parts[p].vertex_ids for p in spec.get("exclude_parts", ()) if p in parts]
+        if left_out:
+            keep = np.ones(len(vertices), bool)
+            keep[np.concatenate(left_out)] = False
+            box = vertices[keep]
     else:
         box = vertices[[fps[k] for k in wanted]]
     lo, hi = box.min(axis=0), box.max(axis=0)
@@ -289,6 +296,15 @@ def _occlusion_factor(n: int, occlusion: Any, strength: np.ndarray | float,
     return occlusion_factor(occlusion, strength=strength, power=power)
 
 
+def _piece_uv(pieces: Sequence[PartMesh], hair_uv: Any) -> list[np.ndarray | None]:
+    """Per piece, the hair card coordinates ``(Vp, 2) float32`` of the ``hair`` piece (the
+    face shader draws strands with them) and None for every other piece."""
+    if hair_uv is None:
+        return [None] * len(pieces)
+    hair_uv = np.asarray(hair_uv, np.float32)
+    return [hair_uv[p.vertex_ids] if p.name == "hair" else None for p in pieces]
+
+
 def _face_arrays(face: Deformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     try:
         vertices = np.asarray(face.vertices, np.float32)
@@ -445,9 +461,14 @@ class FaceRenderer:
         self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
                         for p in self._pieces]
         self._materials = [self._material(p.name) for p in self._pieces]
-        self._interleaved = [np.empty((len(c), 10), np.float32) for c in self._colors]
-        for buf, color in zip(self._interleaved, self._colors, strict=True):
-            buf[:, 6:10] = color
+        self._uv = _piece_uv(self._pieces, getattr(face, "hair_uv", None))
+        # pyrender interleaves position, normal, texcoord_0 (hair only) and colour
+        self._interleaved = [np.empty((len(c), 10 if uv is None else 12), np.float32)
+                             for c, uv in zip(self._colors, self._uv, strict=True)]
+        for buf, color, uv in zip(self._interleaved, self._colors, self._uv, strict=True):
+            buf[:, -4:] = color
+            if uv is not None:
+                buf[:, 6:8] = uv
         if framing is None:
             framing = "head"
         if isinstance(framing, str):
@@ -535,11 +556,12 @@ class FaceRenderer:
     def _new_meshes(self, vertices: np.ndarray, normals: np.ndarray) -> list[Any]:
         pr = self._pr
         meshes = []
-        for piece, color, material in zip(self._pieces, self._colors, self._materials,
-                                          strict=True):
+        for piece, color, material, uv in zip(self._pieces, self._colors, self._materials,
+                                              self._uv, strict=True):
             primitive = pr.Primitive(
                 positions=vertices[piece.vertex_ids],
                 normals=normals[piece.vertex_ids],
+                texcoord_0=uv,
                 color_0=color,
                 indices=piece.triangles,
                 material=material,

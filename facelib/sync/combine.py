@@ -4,10 +4,13 @@ Each step is a small pure function over :class:`FapTrack` objects:
 
 1. :func:`blend` expressions with visemes (mouth conflict, eq. 4.11);
 2. :func:`blend` the result with gaze (eyelid and head conflict, 25 % gaze);
-3. :func:`close_lids` for blinks, which no expression may hold open;
-4. :func:`add_head_noise` where gaze does not move the head;
-5. nods on the stressed syllables (:mod:`facelib.sync.nods`), likewise;
-6. :func:`to_stream`.
+3. idle micro-movements of brows, lids and mouth corners (:mod:`facelib.sync.alive`);
+4. :func:`close_lids` for blinks, which no expression may hold open;
+5. :func:`add_head_noise` where gaze does not move the head;
+6. nods on the stressed syllables (:mod:`facelib.sync.nods`), likewise;
+7. breathing and a listener's head motion, then the eyes' counter-rotation to all of the
+   idle head motion (steps 5-7), so gaze stays on its target;
+8. :func:`to_stream`.
 """
 
 from __future__ import annotations
@@ -19,6 +22,13 @@ from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import ANGLE_UNIT, fap
 from facelib.mpeg4.track import FapTrack
+from facelib.sync.alive import (
+    Liveliness,
+    add_alive_head,
+    add_micro,
+    counter_roll_eyes,
+    eased,
+)
 from facelib.sync.nods import accents, add_nods
 from facelib.sync.noise import perlin1d
 from facelib.sync.rules import HeadNoise, SyncRules
@@ -124,6 +134,7 @@ def combine(
     speaking: np.ndarray | None = None,
     rules: SyncRules | None = None,
     seed: int = 0,
+    liveliness: Liveliness | None = None,
 ) -> FapStream:
     """Resolve the three generators' tracks (all of one length and fps) into a stream.
 
@@ -131,22 +142,33 @@ def combine(
     blinks: ``(n_frames,)`` lid closure in [0, 1] from the eye-behaviour model, or None;
     blink_lids: the (upper, lower) lid values at full closure (``GazeAnimation.blink_lids``);
         needed with ``blinks``.
-    speaking: ``(n_frames,) bool`` where the character talks (livelier head noise).
+    speaking: ``(n_frames,) bool`` where the character talks (livelier head noise, no
+        listening motion).
+    liveliness: amplitude and rate factors of the idle motion (default: all 1).
     """
     seed = check_seed(seed)
     rules = rules or SyncRules.load()
+    lively = liveliness or Liveliness()
     mouth_e, mouth_v = rules.mouth_weights()
     face = blend(expressions, visemes, weight_a=mouth_e, weight_b=mouth_v)
     face = blend(face, gaze, weight_a=rules.eyes_head[0], weight_b=rules.eyes_head[1])
+    alive = rules.alive
+    if alive is not None:
+        talk = eased(speaking, face.n_frames, fps=face.fps, ease_s=alive.listening.ease_s)
+        face = add_micro(face, rules=alive, seed=seed, talk=talk, liveliness=lively)
     if blinks is not None:
         if blink_lids is None:
             raise ParameterError("combine: blinks need blink_lids (GazeAnimation.blink_lids)")
         face = close_lids(face, blinks, closed=blink_lids)
     head_driven = gaze.weight[:, list(HEAD_FAPS)].max(axis=1, initial=0.0)
+    head_before = face.values[:, list(HEAD_FAPS)].astype(np.float64)
     if rules.head_noise is not None:
         face = add_head_noise(face, noise=rules.head_noise, seed=seed,
                               head_driven=head_driven, speaking=speaking)
     if rules.speech_nods is not None:
         face = add_nods(face, strength=accents(visemes, nods=rules.speech_nods),
                         nods=rules.speech_nods, seed=seed, head_driven=head_driven)
+    if alive is not None:
+        face = add_alive_head(face, rules=alive, seed=seed, talk=talk, liveliness=lively)
+        face = counter_roll_eyes(face, head_before=head_before, gain=alive.vor_gain)
     return to_stream(face)

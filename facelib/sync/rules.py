@@ -19,6 +19,7 @@ import numpy as np
 from facelib import data
 from facelib.errors import DataError, FileError
 from facelib.mpeg4.tables import N_FAPS, fap
+from facelib.sync.alive import AliveRules
 from facelib.sync.nods import Nods
 
 __all__ = ["HeadNoise", "SyncRules"]
@@ -60,6 +61,8 @@ class SyncRules:
     expression_importance, viseme_importance: name -> factor in [0, 1] on that side's weight.
     head_noise: idle head motion, or None for none.
     speech_nods: nods on stressed syllables while speaking, or None for none.
+    alive: breathing, listening motion, micro-movements and the eyes' counter-rotation
+        (``facelib/data/alive/idle.json``), or None for none.
     """
 
     mouth: tuple[float, float] = field(default_factory=lambda: _default_rules().mouth)
@@ -72,6 +75,7 @@ class SyncRules:
         default_factory=lambda: _default_rules().viseme_importance)
     head_noise: HeadNoise | None = field(default_factory=lambda: _default_rules().head_noise)
     speech_nods: Nods | None = field(default_factory=lambda: _default_rules().speech_nods)
+    alive: AliveRules | None = field(default_factory=AliveRules.load)
 
     def mouth_weights(self) -> tuple[np.ndarray, np.ndarray]:
         """Per-FAP (expression, viseme) weights of the mouth blend: two ``(84,) float64``

@@ -28,7 +28,7 @@ The chain, each step a function over arrays:
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 from functools import cache
 from typing import Any, Literal
@@ -51,6 +51,7 @@ from facelib.tracking.headframe import (
     to_head_frame,
 )
 from facelib.tracking.layouts import LandmarkLayout, landmark_layout
+from facelib.tracking.neutral import NeutralChoice, neutral_news, neutral_window
 from facelib.tracking.observation import (
     ObservationModel,
     default_observation,
@@ -288,6 +289,7 @@ class MeasuredFrames:
 
 
 _CHUNK_FRAMES = 1024
+_NEUTRAL_SEARCH_FRAMES = 3000  # a first pass over at most about this many frames
 """Frames put in the head frame at a time, so a long track needs a few copies of a chunk's
 landmarks, not of the whole track's."""
 
@@ -402,11 +404,11 @@ def measure_faps(
     layout: a packaged layout name (``"mediapipe"``, ``"ibug68"``) or a
         :class:`~facelib.tracking.layouts.LandmarkLayout`.
     neutral: the neutral frame, or a ``(start, stop)`` span averaged over its frames with a
-        face; None: the first frame with a face. TrackingError when it has none.
+        face; None: the first frame with a face, or :func:`find_neutral`'s span (warned)
+        when that is clearly not neutral. TrackingError when it has none.
     fapu: FAPU overrides in the landmarks' unit (e.g. ``{"MNS": 18.3 / 1024}``).
-    smooth: apply the One Euro filter (both ways) and, with the mouth state, draw open_jaw
-        across brief closures (:func:`~facelib.tracking.lipclosure.bridge_jaw`): the
-        temporal steps that need the whole track.
+    smooth: the steps that need the whole track: the One Euro filter (both ways) and, with
+        the mouth state, open_jaw drawn across brief closures (``lipclosure.bridge_jaw``).
     states: high-level state -> ``(n_frames,) bool`` (``{"pucker": frames}``), eq. 4.17.
     relations: fill untracked FAPs by eq. 4.17.
     rig: the model read off the landmark motion instead of eq. 4.16's one point per FAP:
@@ -427,7 +429,7 @@ def measure_faps(
     rate = check_fps(fps)
     data, layout, model = checked_inputs(landmarks, layout, rig)
     data, filled = fill_gaps(data)
-    rest = _neutral(data, filled, neutral, layout=layout, fapu=fapu)
+    rest = _neutral(data, filled, neutral, fps=rate, layout=layout, model=model, fapu=fapu)
     shifts = _brow_shifts(brows, model, len(data))
     lips = close_lips and model is not None and layout.name == "mediapipe"
     found = _join([measure_frames(data[cut], rest, layout=layout, model=model, lips=lips,
@@ -454,17 +456,50 @@ def _over_time(found: MeasuredFrames, rate: float, closed: np.ndarray | None) ->
 
 
 def _neutral(data: np.ndarray, filled: tuple[int, ...], neutral: int | tuple[int, int] | None,
-             *, layout: LandmarkLayout, fapu: Mapping[str, float] | None) -> Neutral:
-    """:func:`measure_faps`'s neutral face of the gap-filled ``data`` (its ``filled``
-    frames had no face), after a TrackingWarning naming those frames (and the neutral frame
-    chosen, when ``neutral`` is None)."""
+             *, fps: float, layout: LandmarkLayout, model: Model | None,
+             fapu: Mapping[str, float] | None) -> Neutral:
+    """:func:`measure_faps`'s neutral face of the gap-filled ``data`` at ``fps`` (its
+    ``filled`` frames had no face), after a TrackingWarning naming those frames, and one
+    when ``neutral`` is None and the first frame with a face is not neutral
+    (:func:`find_neutral`)."""
     span = neutral_span(neutral, len(data), lost=filled)
     if filled:
         news = f"no face in frames {frame_spans(np.array(filled))} of {len(data)}; interpolated"
         if neutral is None and span.start:
             news += f"; the neutral is frame {span.start}, the first with a face"
         warnings.warn(TrackingWarning(news), stacklevel=3)
+    if neutral is None:
+        choice = find_neutral(data, fps=fps, layout=layout, rig=model, first=span.start,
+                              excluded=filled)
+        if choice.searched:
+            warnings.warn(TrackingWarning(neutral_news(choice, span.start)), stacklevel=3)
+        span = choice.span
     return neutral_face(data, layout=layout, span=span, fapu=fapu, lost=filled)
+
+
+def find_neutral(landmarks: np.ndarray, *, fps: float,
+                 layout: str | LandmarkLayout = "mediapipe",
+                 rig: Model | Literal["auto", "default", "observed"] | None = "auto",
+                 first: int = 0, excluded: Collection[int] = ()) -> NeutralChoice:
+    """The neutral frames of ``(n, K, D)`` landmarks (NaN rows: no face) at ``fps`` when
+    the user names none: frame ``first`` (the first with a face, or a well-lit one) unless
+    a first pass of :func:`measure_frames` against it, with ``layout`` and ``rig`` as for
+    :func:`measure_faps`, finds it clearly not neutral
+    (:func:`~facelib.tracking.neutral.neutral_window`; ``excluded`` frames are never the
+    neutral). Long tracks are searched at about :data:`_NEUTRAL_SEARCH_FRAMES` frames."""
+    data, layout, model = checked_inputs(landmarks, layout, rig)
+    data, lost = fill_gaps(data)
+    rest = neutral_face(data, layout=layout, span=slice(first, first + 1), lost=lost)
+    step = max(1, len(data) // _NEUTRAL_SEARCH_FRAMES)
+    values = np.concatenate([measure_frames(data[::step][cut], rest, layout=layout,
+                                            model=model, lips=False).values
+                             for cut in _chunks(len(data[::step]))])
+    skip = {i // step for i in {*lost, *excluded} if i % step == 0}
+    found = neutral_window(values, fps=fps / step, first=-(-first // step), excluded=skip)
+    if not found.searched:
+        return NeutralChoice(slice(first, first + 1))
+    span = slice(found.span.start * step, (found.span.stop - 1) * step + 1)
+    return NeutralChoice(span, found.jaw_below)
 
 
 def landmarks_to_faps(landmarks: np.ndarray, *, fps: float, **options: object) -> FapStream:

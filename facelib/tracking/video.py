@@ -25,9 +25,10 @@ from facelib.checks import check_count
 from facelib.errors import TrackingError, TrackingWarning
 from facelib.optional import require
 from facelib.tracking.browimage import track_brows
-from facelib.tracking.faps import TrackedFaps, frame_spans, measure_faps
+from facelib.tracking.faps import TrackedFaps, find_neutral, frame_spans, measure_faps
 from facelib.tracking.headframe import face_found
 from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
+from facelib.tracking.neutral import NeutralChoice, neutral_news
 from facelib.tracking.observation import ObservationModel, default_observation
 
 log = logging.getLogger("facelib.tracking")
@@ -87,6 +88,18 @@ class VideoTrack:
         if np.isfinite(light).any():
             found = found[light >= 0.8 * np.nanmedian(light)]
         return int(found[0])
+
+    def default_neutral(self) -> NeutralChoice:
+        """The neutral frames when the user names none: :attr:`first_lit_face` unless
+        :func:`~facelib.tracking.faps.find_neutral` finds it clearly not neutral (then
+        the most neutral well-lit span, with a TrackingWarning)."""
+        lit = np.isfinite(self.light)
+        dim = np.flatnonzero(self.light < 0.8 * np.nanmedian(self.light)) if lit.any() else ()
+        first = self.first_lit_face
+        choice = find_neutral(self.landmarks, fps=self.info.fps, first=first, excluded=dim)
+        if choice.searched:
+            warnings.warn(TrackingWarning(neutral_news(choice, first)), stacklevel=2)
+        return choice
 
 
 def _face_light(image: np.ndarray, box: np.ndarray) -> float:
@@ -267,11 +280,13 @@ def track_video_faps(path: str | os.PathLike[str], *, max_frames: int | None = N
                      **options: Any) -> tuple[VideoTrack, TrackedFaps]:
     """:func:`track_video`, then :func:`~facelib.tracking.faps.measure_faps` at the video's
     frame rate (``options`` go to it: ``neutral``, by default the first frame with a
-    well-lit face, :attr:`VideoTrack.first_lit_face`; ``fapu``, ``smooth``, ``states``) with
+    well-lit face, :meth:`VideoTrack.default_neutral`; ``fapu``, ``smooth``, ``states``) with
     the brows' image shifts (:func:`video_brows`) for the learned model (``rig``
     ``"auto"``, ``"observed"`` or an observation model) unless ``brows=None`` is given."""
     track = track_video(path, max_frames=max_frames)
-    options.setdefault("neutral", track.first_lit_face)
+    if options.get("neutral") is None:
+        span = track.default_neutral().span
+        options["neutral"] = (span.start, span.stop)
     rig = options.get("rig", "auto")
     if "brows" not in options and (rig in ("auto", "observed")
                                    or isinstance(rig, ObservationModel)):

@@ -36,8 +36,8 @@ from facelib.visemes.scripts import visemes_from_cues
 from facelib.visemes.tables import loudness_rules, timing_rules
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
-__all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate",
-           "speech_timeline", "synthesize", "timeline_from_text"]
+__all__ = ["SpeechAudio", "VisemeAnimation", "align", "align_dtw", "animate", "animate_spoken",
+           "speech_timeline", "spoken", "synthesize", "timeline_from_text"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -183,6 +183,27 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
     fps = check_fps(fps)
     rate = check_number("rate", rate, low=0.25, high=4.0)
     own, audio = _spoken(speech, rate=rate, language=language)
+    return animate_spoken(speech, own, audio, fps=fps, max_frames=max_frames)
+
+
+def spoken(speech: SpeechSpec, *, rate: float = 1.0, language: str | None = None,
+           ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+    """The timeline of ``speech`` in its own time (as :func:`speech_timeline`) and its
+    synthesized audio (None for a recording or a viseme script): the slow half of
+    :func:`animate`, which a live session runs once per sentence before it knows when the
+    sentence will start."""
+    speech = check_kind("speech", speech, SpeechSpec)
+    rate = check_number("rate", rate, low=0.25, high=4.0)
+    return _spoken(speech, rate=rate, language=language)
+
+
+def animate_spoken(speech: SpeechSpec, own: SpeechTimeline, audio: SpeechAudio | None, *,
+                   fps: float, max_frames: int = MAX_FRAMES) -> VisemeAnimation:
+    """:func:`animate` of ``speech`` whose timeline ``own`` (in its own ms, from
+    :func:`spoken` or a recognizer) and ``audio`` are known: the curves start at
+    ``speech.start_ms``. ``audio`` (samples at their rate) gives the loudness that drives
+    the jaw; without it a recording named by ``speech.audio`` does."""
+    fps = check_fps(fps)
     timeline = own.shifted(speech.start_ms)
     # through the envelope's release ramp, so the mouth is seen settling back to neutral
     end_ms = speech.start_ms + timeline.duration_ms + timing_rules()["envelope_ramp_ms"]

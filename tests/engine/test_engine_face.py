@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facelib.engine import OPTIONAL_PARTS, PART_NAMES, Face
+from facelib.engine import ATTACHED_PARTS, OPTIONAL_PARTS, PART_NAMES, Face
 from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap, fap_table
@@ -24,13 +24,16 @@ def test_mesh_arrays_and_parts(face: Face) -> None:
     assert t.dtype == np.int32 and t.shape[1] == 3 and t.max() < len(v)
     assert c.shape == v.shape and c.min() >= 0 and c.max() <= 1
     assert not v.flags.writeable
-    assert tuple(face.parts) == (*PART_NAMES, *OPTIONAL_PARTS)
+    assert tuple(face.parts) == (*PART_NAMES, *OPTIONAL_PARTS, *ATTACHED_PARTS)
     covered = sum(len(p.triangles) for p in face.parts.values())
     assert covered == len(t)
     ids = np.concatenate([p.vertex_ids for p in face.parts.values()])
     assert np.array_equal(np.sort(ids), np.arange(len(v)))
-    # a head about 25 cm tall, looking along +z, symmetric about x = 0
-    extent = v.max(0) - v.min(0)
+    # a head about 25 cm tall (skin), looking along +z, symmetric about x = 0; the bust and
+    # hair are appended after every head vertex
+    assert face.parts["bust"].vertex_ids.min() == face.parts["lashes"].vertex_ids.max() + 1
+    skin = face.parts["skin"].vertex_ids
+    extent = v[skin].max(0) - v[skin].min(0)
     assert 0.18 < extent[1] < 0.32 and 0.12 < extent[0] < 0.2
     assert v[face.feature_points["9.3"], 2] == pytest.approx(v[:, 2].max(), abs=0.005)
     assert v[face.feature_points["3.5"], 0] > 0 > v[face.feature_points["3.6"], 0]
@@ -156,9 +159,14 @@ def test_head_rotates_about_its_pivot(face: Face, name, plane, sign_axis, fap_fr
     assert _angle(before, after) == pytest.approx(0.15, rel=1e-3)
     direction = 1.0 if name == "head_yaw" else -1.0  # yaw left (+x), pitch down (-y)
     assert direction * (moved[tip] - face.vertices[tip])[sign_axis] > 0
-    # the neck cut stays where it is
-    low = neck_border(face)
+    # the bust's bottom stays where it is; the neck between blends (the head's old cut,
+    # now the seam to the bust, turns part of the way)
+    bust = face.parts["bust"].vertex_ids
+    low = bust[face.vertices[bust, 1] < face.vertices[bust, 1].min() + 0.05]
     np.testing.assert_allclose(moved[low], face.vertices[low], atol=1e-6)
+    seam = neck_border(face)
+    turned = np.linalg.norm(moved[seam] - face.vertices[seam], axis=1)
+    assert 0 < turned.max() < np.linalg.norm(moved[tip] - face.vertices[tip])
 
 
 def test_head_roll_tips_the_top_to_the_right(face: Face, fap_frame) -> None:

@@ -77,7 +77,8 @@ def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
     # widest, moves about half of it)
     assert all(s is not None and 0 < s.count < 0.6 * g.accessors[skin.attributes.POSITION].count
                for s in moved)
-    assert [p.material for p in g.meshes[0].primitives] == list(range(7))  # 6 parts, lashes
+    # 6 parts, lashes, and the attached bust, garment and hair
+    assert [p.material for p in g.meshes[0].primitives] == list(range(10))
     extras = g.asset.extras["facelib"]
     assert extras["n_frames"] == 12 and extras["fps"] == 25
 

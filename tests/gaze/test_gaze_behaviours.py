@@ -10,6 +10,7 @@ from facelib.errors import FdlError
 from facelib.gaze import GAZE_FAPS, animate, bind_behaviour, simulate
 from facelib.gaze.behaviours import merge_behaviours
 from facelib.gaze.model import gaze_model
+from facelib.gaze.norms import head_eye_rule
 
 DEG_AU = np.pi / 180 / 1e-5
 
@@ -29,10 +30,11 @@ def test_lookto_left_with_head_turns_eyes_and_head_left():
     assert move.start - look.start == pytest.approx(gaze_model()["head"]["latency_s"])
 
 
-def test_lookto_without_head_keeps_the_head_still():
-    anim = simulate("lookTo", "upright", 12.0, "no", seconds=1.0, seed=0)
+def test_a_small_lookto_without_head_keeps_the_head_still():
+    """Below the head-eye rule's onset (alive/head_eye.json, 10 deg) the eyes move alone."""
+    anim = simulate("lookTo", "upright", 9.0, "no", seconds=1.0, seed=0)
     assert not anim.head_moves and np.abs(anim.head).max() == 0
-    target = [-12 * np.sqrt(0.5), 12 * np.sqrt(0.5)]
+    target = [-9 * np.sqrt(0.5), 9 * np.sqrt(0.5)]
     assert anim.gaze[-1] == pytest.approx(target, abs=1e-6)
     # the eyes hold the target up to their fixational drift and micro-saccades (< 0.5 deg)
     assert np.hypot(*(anim.eyes[-1] - target)) < 0.5
@@ -43,7 +45,7 @@ def test_lookto_without_head_keeps_the_head_still():
 
 def test_large_statistical_shifts_recruit_the_head():
     anim = simulate("default", "talking", seconds=600, seed=4)
-    threshold = gaze_model()["head"]["threshold_deg"]
+    threshold = head_eye_rule().onset_deg
     big = [s for s in anim.saccades if s.kind == "away" and s.head > 0]
     assert big, "some looks away must exceed the head threshold"
     assert all(s.head > 0 for s in anim.saccades if s.magnitude > 2 * threshold + 2)

@@ -31,14 +31,26 @@ from facelib.tracking.closedloop import (  # noqa: E402
 )
 from facelib.visemes.timeline import bilabial_spans  # noqa: E402
 
-FLOORS = {3: 0.82, 6: 0.9, 7: 0.9, 12: 0.9, 13: 0.88, 19: 0.88, 20: 0.88, 21: 0.88, 22: 0.88,
-          23: 0.9, 24: 0.9}
-"""open_jaw, lip corners (stretch 6/7, raise 12/13), upper and lower lids, eyeball yaw. On
-these 110 frames the default head measures 0.93, 0.97/0.97, 0.99/0.98, 0.97/0.96,
-0.97/0.96, 0.97/0.96 and the SOMA-X head 0.92, 0.98/0.98, 0.98/0.96, 0.94/0.94, 0.95/0.97,
-0.97/0.97 (the model trained with pushes of a third of each FAP's reach, lower lids
-included, the gaze from the eyes and face oval alone, the One Euro filter run both ways,
-the jaw drawn across brief closures)."""
+FLOORS = {3: 0.82, 6: 0.9, 7: 0.9, 12: 0.9, 13: 0.88, 19: 0.88, 20: 0.88, 21: 0.82, 22: 0.82,
+          23: 0.75, 24: 0.75}
+"""open_jaw, lip corners (stretch 6/7, raise 12/13), upper and lower lids, eyeball yaw, over
+all 110 frames. Measured with issue 32's blink norms and head-eye rule: the default head
+0.93, 0.96/0.97, 0.95/0.93, 0.94/0.96, 0.88/0.86, 0.81/0.82 and the SOMA-X head 0.92,
+0.96/0.97, 0.93/0.93, 0.96/0.94, 0.90/0.91, 0.85/0.87. The lower-lid floors were 0.88 and the
+eyeball-yaw floors 0.9 before issue 32 (then 0.97/0.96 and 0.97/0.96 on the default head):
+the clip's 18 deg lookTo right now carries a gaze-evoked blink (as people blink on large
+shifts), so the lids are shut in frames 105-108 just as the eyes swing 28 deg and no tracker
+sees an iris under a closed lid. Where the lids are open the old floors still hold and are
+kept in OPEN_LID_FLOORS (default head 0.90/0.89 lower lids, 0.95/0.95 eyeball yaw; SOMA-X
+0.93/0.93, 0.97/0.97)."""
+OPEN_LID_FLOORS = {21: 0.85, 22: 0.85, 23: 0.9, 24: 0.9}
+
+
+def open_lid_correlation(loop, fap_id: int) -> float:
+    """Correlation of the true and recovered FAP over the frames whose upper lid is open."""
+    truth, found = loop.truth.values, loop.tracked.stream.values
+    open_ = truth[:, 18] < 300  # FAP 19 under 300 IRISD units: the iris can be seen
+    return float(np.corrcoef(truth[open_, fap_id - 1], found[open_, fap_id - 1])[0, 1])
 
 
 @pytest.fixture(scope="module")
@@ -76,6 +88,8 @@ def test_face_faps_follow_the_truth(loop):
     # units), so the corners are compared on the inner-lip FAPs 6/7 and 12/13
     found = {fap_id: round(loop.correlation(fap_id), 3) for fap_id in FLOORS}
     assert all(found[k] > v for k, v in FLOORS.items()), found
+    seen = {fap_id: round(open_lid_correlation(loop, fap_id), 3) for fap_id in OPEN_LID_FLOORS}
+    assert all(seen[k] > v for k, v in OPEN_LID_FLOORS.items()), seen
     assert 0.6 < loop.gain(3) < 1.2       # open_jaw's amplitude comes back (0.78; 0.35 once)
 
 
@@ -90,6 +104,8 @@ def test_the_learned_model_beats_the_rig_fit(loop):
 def test_soma_head_follows_the_truth(soma_loop):
     found = {fap_id: round(soma_loop.correlation(fap_id), 3) for fap_id in FLOORS}
     assert all(found[k] > v for k, v in FLOORS.items()), found
+    seen = {k: round(open_lid_correlation(soma_loop, k), 3) for k in OPEN_LID_FLOORS}
+    assert all(seen[k] > v for k, v in OPEN_LID_FLOORS.items()), seen
     assert soma_loop.correlation(49) > 0.95
     for fap_id in (19, 20):
         events = closure_events(soma_loop.truth.values[:, fap_id - 1], 600)
@@ -167,3 +183,13 @@ def test_inner_brows_come_back_with_the_image(expressive_loops):
             assert loop.correlation(fap_id) > 0.9, fap_id
             alone = np.corrcoef(loop.truth.values[:, fap_id - 1], plain[:, fap_id - 1])[0, 1]
             assert loop.correlation(fap_id) > alone + 0.05, fap_id
+
+
+def test_a_neutral_start_is_kept_as_the_neutral(loop, soma_loop):
+    """With no neutral given, speech with lip presses and head turns keeps its first frame
+    (facelib.tracking.neutral: presses read as a jaw closing in too few frames)."""
+    from facelib.tracking.faps import find_neutral
+
+    for one in (loop, soma_loop):
+        points = np.concatenate([one.lead, one.landmarks])
+        assert not find_neutral(points, fps=one.truth.fps).searched

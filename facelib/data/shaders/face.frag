@@ -14,6 +14,16 @@
 // glint in it either).
 // Output: linear colour to sRGB with gamma 1/2.2, as pyrender's own shader does.
 // WRAP and SPECULAR are #defines filled in from render_look.json ("shading").
+//
+// Hair cards (primitives with texcoord_0 = (card index + across the card, root 0 to tip 1))
+// are shaded as strands instead (Kajiya-Kay): the strand tangent t is the direction in which
+// the root-to-tip coordinate grows (its world-space gradient over the triangle, from screen
+// derivatives, so no tangents need uploading per frame); the highlight follows
+// sin(t, h)^s = sqrt(1 - (t.h)^2)^s, a white lobe with the tangent shifted toward the root
+// (HAIR_SHIFT) and a wider, hair-coloured second lobe shifted toward the tip, as light
+// reflected inside the fibre comes out. The card is cut into HAIR_STRANDS strands across,
+// each a little lighter or darker and ending a little earlier (HAIR_TIPS), so a card reads
+// as a lock of hair, not a ribbon. Both faces of a card are lit (normal toward the viewer).
 
 struct DirectionalLight {
     vec3 color;
@@ -43,6 +53,22 @@ out vec4 frag_color;
 
 const float PI = 3.141592653589793;
 
+#ifdef TEXCOORD_0_LOC
+in vec2 hair_uv;
+
+float strand_hash(float n)
+{
+    return fract(sin(n * 12.9898) * 43758.5453);
+}
+
+// Kajiya-Kay highlight of a strand with unit tangent t for the half vector h
+float strand_lobe(vec3 t, vec3 h, float exponent)
+{
+    float th = dot(t, h);
+    return pow(sqrt(max(1.0 - th * th, 0.0)), exponent);
+}
+#endif
+
 void main()
 {
     vec3 n = normalize(world_normal);
@@ -56,6 +82,36 @@ void main()
 
     vec3 diffuse = vec3(0.0);
     vec3 specular = vec3(0.0);
+#ifdef TEXCOORD_0_LOC
+    vec3 dp1 = dFdx(world_position);
+    vec3 dp2 = dFdy(world_position);
+    float dv1 = dFdx(hair_uv.y);
+    float dv2 = dFdy(hair_uv.y);
+    vec3 across = cross(dp1, dp2);
+    vec3 grad = dv1 * cross(dp2, across) + dv2 * cross(across, dp1);
+    vec3 t = grad / max(length(grad), 1e-20);
+    float strand = floor(fract(hair_uv.x) * float(HAIR_STRANDS)) + 17.0 * floor(hair_uv.x);
+    float luck = strand_hash(strand);
+    if (hair_uv.y > 1.0 - float(HAIR_TIPS) * luck) {
+        discard;
+    }
+    if (dot(n, v) < 0.0) {
+        n = -n;
+    }
+    base *= 0.72 + 0.56 * luck;
+    vec3 t1 = normalize(t + float(HAIR_SHIFT) * n);
+    vec3 t2 = normalize(t - float(HAIR_SHIFT) * n);
+    for (int i = 0; i < n_directional_lights; i++) {
+        vec3 l = -normalize(directional_lights[i].direction);
+        vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
+        float nl = dot(n, l);
+        diffuse += radiance * max((nl + wrap) / (1.0 + wrap), 0.0);
+        vec3 h = normalize(l + v);
+        float lit = smoothstep(-0.1, 0.4, nl);
+        specular += radiance * lit * (float(HAIR_SHINE) * strand_lobe(t1, h, float(HAIR_GLOSS))
+                                      + float(HAIR_SHEEN) * strand_lobe(t2, h, 0.25 * float(HAIR_GLOSS)) * 4.0 * base);
+    }
+#else
     for (int i = 0; i < n_directional_lights; i++) {
         vec3 l = -normalize(directional_lights[i].direction);
         vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
@@ -64,6 +120,7 @@ void main()
         float nh = max(dot(n, normalize(l + v)), 0.0);
         specular += radiance * (lobe * pow(nh, shininess) * max(nl, 0.0));
     }
+#endif
     vec3 color = base * (diffuse / PI + ambient_light) + occlusion * specular;
     frag_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);
 }

@@ -3,11 +3,16 @@
 // colour (sRGB converted to linear, ambient occlusion already multiplied in) to face.frag,
 // and the occlusion factor itself (the colour's alpha), which dims the highlights.
 // Attribute locations and the M/V/P uniforms are the ones pyrender binds for any mesh.
+// Hair cards (the only primitives with texture coordinates) pass their card coordinates on.
 
 layout(location = 0) in vec3 position;
 layout(location = NORMAL_LOC) in vec3 normal;
 #ifdef COLOR_0_LOC
 layout(location = COLOR_0_LOC) in vec4 color_0;
+#endif
+#ifdef TEXCOORD_0_LOC
+layout(location = TEXCOORD_0_LOC) in vec2 texcoord_0;  // hair cards: (card + across, root to tip)
+out vec2 hair_uv;
 #endif
 layout(location = INST_M_LOC) in mat4 inst_m;
 
@@ -27,6 +32,9 @@ void main()
     gl_Position = P * V * world;
     world_position = world.xyz;
     world_normal = mat3(transpose(inverse(model))) * normal;
+#ifdef TEXCOORD_0_LOC
+    hair_uv = texcoord_0;
+#endif
 #ifdef COLOR_0_LOC
     albedo = color_0.rgb;
     occlusion = color_0.a;

@@ -1,0 +1,236 @@
+"""The incremental engine of a live session: input placed on a frame clock, frames
+committed once and never changed.
+
+The engine keeps a :class:`~facelib.live.plan.Plan` per epoch and runs the offline
+pipeline over a window from the epoch's first frame (:func:`facelib.live.plan.window`),
+ahead of the frames it has handed out. New input goes no earlier than the first frame not
+yet handed out (``lead_ms`` later for speech, whose envelope ramps in before it starts), and
+every generator is causal, so the frames already handed out are those a recomputation with
+the new input would give: the session's frames are the offline pipeline's.
+
+An epoch ends when the session is quiet (nothing said or shown) and it has lasted
+``epoch_s``: the next one starts at the next frame with a seed of its own, and the face
+cross-fades from the old epoch's eyes and head to the new one's over ``crossfade_ms``, so
+the window (time and memory per frame) stays bounded however long the session runs. Time
+here is the engine's own (frames at ``fps`` from 0); :class:`facelib.live.session.Session`
+ties it to the wall clock.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from facelib.checks import check_fps, check_number, check_seed
+from facelib.cues import CameraCue, ExpressionCue, GazeCue, SpeechSpec
+from facelib.errors import ParameterError
+from facelib.live.plan import Plan, Utterance, Window, window
+from facelib.sync import SyncRules
+from facelib.visemes.animate import SpeechAudio, animate_spoken
+from facelib.visemes.tables import timing_rules
+from facelib.visemes.timeline import SpeechTimeline
+
+__all__ = ["Engine", "Frame"]
+
+_AHEAD_S = 1.0
+"""How far past the requested frame a window is computed (s): one recomputation serves
+this many frames when no input comes."""
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One output frame.
+
+    index: frame number from the session's start; ``time_ms`` = ``index * 1000 / fps``.
+    faps: ``(84,) float32`` FAP values (FAP k in column k-1; 0 where nothing drives it).
+    mask: ``(84,) bool``, the FAPs set in this frame.
+    viseme: the MPEG-4 viseme id (0-14) shown, or -1 when nothing is said.
+    speaking: whether the character speaks at this frame.
+    """
+
+    index: int
+    time_ms: float
+    faps: np.ndarray
+    mask: np.ndarray
+    viseme: int
+    speaking: bool
+
+
+@dataclass
+class _Epoch:
+    start: int  # first frame (session frames)
+    plan: Plan
+    window: Window | None = None
+
+
+class Engine:
+    """Frames of a live session on its own clock (see the module's docstring).
+
+    fps: output frame rate; seed: seed of the first epoch (each later one derives its own);
+    epoch_s: least length of an epoch; crossfade_ms: the blend between epochs.
+    """
+
+    def __init__(self, *, fps: float = 30.0, seed: int = 0, epoch_s: float = 60.0,
+                 crossfade_ms: int = 400, rules: SyncRules | None = None) -> None:
+        self.fps = check_fps(fps)
+        self.seed = check_seed(seed)
+        self.epoch_frames = math.ceil(check_number("epoch_s", epoch_s, low=1.0) * self.fps)
+        self.crossfade_frames = max(1, round(crossfade_ms * self.fps / 1000))
+        self.rules = rules or SyncRules.load()
+        self.lead_ms = int(timing_rules()["envelope_ramp_ms"])
+        self.committed = 0  # frames handed out
+        self._epoch = _Epoch(0, Plan(self.fps, self.seed))
+        self._previous: _Epoch | None = None
+        self._epochs = 1
+
+    # -- time --------------------------------------------------------------------------
+    def frame_ms(self, index: int) -> float:
+        """Time of session frame ``index`` (ms)."""
+        return index * 1000.0 / self.fps
+
+    @property
+    def now_ms(self) -> int:
+        """The earliest time new input may start: the first frame not yet handed out (ms,
+        rounded up)."""
+        return math.ceil(self.frame_ms(self.committed))
+
+    @property
+    def speech_end_ms(self) -> int:
+        """End of the last utterance placed (ms, session clock), or 0."""
+        e = self._epoch
+        ends = [u.end_ms for u in e.plan.utterances]
+        return round(self.frame_ms(e.start)) + max(ends) if ends else 0
+
+    @property
+    def content_end_ms(self) -> float:
+        """Time of the frame after the last one the cues and speech placed so far drive
+        (session ms): where a session that is told to stop may end."""
+        e = self._epoch
+        return self.frame_ms(e.start + e.plan.content_frames)
+
+    def _local(self, at_ms: int) -> int:
+        return at_ms - round(self.frame_ms(self._epoch.start))
+
+    def place(self, at_ms: int | None, *, lead_ms: int = 0) -> int:
+        """Session ms where input asked for at ``at_ms`` (None: now) goes: no earlier than
+        ``now_ms + lead_ms``."""
+        earliest = self.now_ms + lead_ms
+        return earliest if at_ms is None else max(int(at_ms), earliest)
+
+    # -- input -------------------------------------------------------------------------
+    def add_speech(self, timeline: SpeechTimeline, audio: SpeechAudio | None, *,
+                   playback: SpeechAudio | None = None,
+                   text: str | None = None, at_ms: int | None = None,
+                   style: str | float = "normal", replace_last: bool = False,
+                   lead_ms: int | None = None) -> int:
+        """Place speech with a known ``timeline`` (its own ms) and ``audio`` no earlier than
+        now plus the envelope's ramp and after the speech already placed (``replace_last``:
+        instead of the last utterance, at its start: streamed audio that grew). ``audio``
+        drives the jaw; ``playback`` (default ``audio``) is what :meth:`audio` plays.
+        ``lead_ms`` (default: the ramp) shortens the lead for streamed audio, whose mouth
+        then starts from where the frames out left it. Returns its start (session ms)."""
+        plan = self._epoch.plan
+        utterances = list(plan.utterances)
+        if replace_last and utterances:
+            start = round(self.frame_ms(self._epoch.start)) + utterances.pop().start_ms
+        else:
+            lead = self.lead_ms if lead_ms is None else lead_ms
+            start = max(self.place(at_ms, lead_ms=lead), self.speech_end_ms)
+        spec = SpeechSpec(text=text, start_ms=self._local(start), style=style)
+        animation = animate_spoken(spec, timeline, audio, fps=self.fps)
+        utterances.append(Utterance(self._local(start), timeline, animation, audio, text,
+                                    playback or audio))
+        self._set(replace(plan, utterances=tuple(utterances)))
+        return start
+
+    def add_cues(self, expressions: tuple[ExpressionCue, ...] = (),
+                 gaze: tuple[GazeCue, ...] = (), camera: tuple[CameraCue, ...] = (), *,
+                 at_ms: int | None = None) -> int:
+        """Place cues whose times count from ``at_ms`` (None: now; never before now).
+        Returns the session ms they count from."""
+        start = self.place(at_ms)
+        shift = self._local(start)
+        plan = self._epoch.plan
+        self._set(replace(
+            plan,
+            expressions=plan.expressions + tuple(
+                replace(c, start_ms=c.start_ms + shift) for c in expressions),
+            gaze=plan.gaze + tuple(replace(c, start_ms=c.start_ms + shift) for c in gaze),
+            camera=plan.camera + tuple(replace(c, start_ms=c.start_ms + shift) for c in camera),
+        ))
+        return start
+
+    def _set(self, plan: Plan) -> None:
+        self._epoch.plan = plan
+        self._epoch.window = None  # the frames handed out stay as they were (causality)
+
+    # -- output ------------------------------------------------------------------------
+    def advance(self, until_ms: float) -> list[Frame]:
+        """Hand out every frame before ``until_ms`` (session ms) not yet handed out."""
+        last = math.ceil(until_ms * self.fps / 1000 - 1e-9)
+        out = []
+        while self.committed < last:
+            self._maybe_new_epoch()
+            out.append(self._frame(self.committed))
+            self.committed += 1
+        return out
+
+    def _rows(self, epoch: _Epoch, index: int) -> tuple[np.ndarray, np.ndarray, int, bool]:
+        local = index - epoch.start
+        if epoch.window is None or local >= epoch.window.n_frames:
+            ahead = local + 1 + round(_AHEAD_S * self.fps)
+            epoch.window = window(epoch.plan, n_frames=ahead, rules=self.rules)
+        w = epoch.window
+        return (w.stream.values[local], w.stream.mask[local], int(w.visemes[local]),
+                bool(w.speaking[local]))
+
+    def _frame(self, index: int) -> Frame:
+        values, mask, viseme, speaking = self._rows(self._epoch, index)
+        previous = self._previous
+        if previous is not None:
+            a = (index - self._epoch.start + 1) / (self.crossfade_frames + 1)
+            old, old_mask, _, _ = self._rows(previous, index)
+            values = ((1 - a) * old + a * values).astype(np.float32)
+            mask = mask | old_mask
+            if index - self._epoch.start + 1 >= self.crossfade_frames:
+                self._previous = None
+        return Frame(index, self.frame_ms(index), np.array(values, np.float32),
+                     np.array(mask, bool), viseme, speaking)
+
+    def _maybe_new_epoch(self) -> None:
+        """Start the next epoch at the next frame when this one is long and quiet."""
+        e = self._epoch
+        local = self.committed - e.start
+        if local < self.epoch_frames or self._previous is not None:
+            return
+        if local < e.plan.content_frames:
+            return
+        self._previous = e
+        seed = (self.seed * 1_000_003 + self._epochs) % 2**63
+        self._epochs += 1
+        self._epoch = _Epoch(self.committed, Plan(self.fps, seed))
+
+    def audio(self, first_ms: float, last_ms: float, *, sample_rate: int) -> np.ndarray:
+        """``(n,) float32`` speech placed in ``[first_ms, last_ms)`` (session ms) at
+        ``sample_rate`` (the utterances' ``playback``; others are not heard), silence
+        elsewhere."""
+        if last_ms < first_ms:
+            raise ParameterError(f"audio: {last_ms} ms is before {first_ms} ms")
+        first = round(first_ms * sample_rate / 1000)
+        n = round(last_ms * sample_rate / 1000) - first
+        out = np.zeros(n, np.float32)
+        for epoch in (self._previous, self._epoch):
+            if epoch is None:
+                continue
+            base = round(self.frame_ms(epoch.start) * sample_rate / 1000)
+            for u in epoch.plan.utterances:
+                sound = u.playback
+                if sound is None or sound.sample_rate != sample_rate:
+                    continue
+                at = base + round(u.start_ms * sample_rate / 1000) - first
+                lo, hi = max(at, 0), min(at + sound.samples.size, n)
+                if hi > lo:
+                    out[lo:hi] += sound.samples[lo - at:hi - at]
+        return out

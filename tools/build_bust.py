@@ -1,0 +1,261 @@
+"""Give facelib's default head a neck, shoulders and a simple garment (a crew-neck top).
+
+Usage (from the repository root)::
+
+    PYTHONPATH=. python tools/build_bust.py            # writes facelib/data/head/default_bust.npz
+    PYTHONPATH=. python tools/build_bust.py --check    # builds, reports, writes nothing
+
+The head mesh ends in one planar loop at the bottom of the neck. The bust is lofted from that
+loop down: ``RINGS`` below are horizontal cross-sections (superellipses: half-width ``a``
+across the shoulders, half-depth ``b``, exponent ``n``; the higher, the squarer), each tilted
+front to back by ``tilt`` (metres at the front, the opposite at the back), with a cubic
+spline through them along every column of the loop, so the surface starts on the head's own
+loop vertices (the bust's first row *is* the loop: no gap, and smooth normals across the
+seam, since the renderer averages the normals of both sides' triangles there) and flares into
+the shoulders. The first rings blend the loop's own shape into the ellipses.
+
+The garment is a second surface 4 mm outside the skin from a neckline down (lower at the front,
+a slight scoop), its top edge rolled into a ribbed collar that tucks 1 mm under the skin.
+Colours: the neck continues the loop's skin colours (the head's baked neck fade toward the cut
+is undone here once: the bust continues the neck, so nothing fades into the background any
+more); ``skin_tone.json`` says so for rebuilt heads). Ambient occlusion is baked with
+``tools/bake_head_look.py``'s depth maps over head and bust together.
+
+The file ``default_bust.npz`` holds ``vertices (B, 3) float32``, ``triangles (F, 3) int32``
+indexing the head's vertices (``< base``) and the bust's (``base + i``), ``vertex_colors (B,
+3) uint8``, ``vertex_ao (B,) uint8``, ``base`` (the head's vertex count), ``seam (S,) int32``
+(the head vertices it attaches to) with their positions ``seam_vertices (S, 3)`` (the loader
+refuses the bust on another head), and ``parts``: the first ``garment_start`` vertices are the
+bust's skin, the rest the garment. Deterministic: no randomness.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+ROOT = Path(__file__).resolve().parent.parent
+HEAD = ROOT / "facelib" / "data" / "head"
+OUT = HEAD / "default_bust.npz"
+
+# y (m, at the column's side), tilt (m: front lower when negative), a, b (m), n, centre z (m)
+RINGS = np.array([
+    (-0.132, 0.006, 0.056, 0.050, 2.0, 0.006),
+    (-0.144, 0.000, 0.059, 0.052, 2.0, 0.004),
+    (-0.152, -0.008, 0.066, 0.056, 2.1, 0.001),
+    (-0.158, -0.013, 0.092, 0.066, 2.2, -0.003),
+    (-0.165, -0.016, 0.125, 0.078, 2.3, -0.006),
+    (-0.176, -0.017, 0.152, 0.089, 2.4, -0.008),
+    (-0.192, -0.016, 0.172, 0.097, 2.5, -0.008),
+    (-0.214, -0.012, 0.183, 0.103, 2.5, -0.008),
+    (-0.245, -0.008, 0.186, 0.108, 2.5, -0.008),
+    (-0.290, -0.004, 0.180, 0.111, 2.5, -0.008),
+    (-0.360, 0.000, 0.172, 0.113, 2.5, -0.008),
+    (-0.440, 0.000, 0.166, 0.113, 2.5, -0.008),
+])
+LOOP_SHAPE = (0.7, 0.35)  # how much of the loop's own shape rings 1 and 2 keep
+SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
+NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
+GARMENT_OFFSET = 0.004  # metres outside the skin
+COLLAR = (-0.001, 0.0065, 0.18)  # tucked edge offset, rib offset (m), rib height (ring index)
+GARMENT_RGB = np.array([0.21, 0.27, 0.37])  # sRGB, a slate-blue top
+COLLAR_RGB = np.array([0.17, 0.22, 0.31])
+# what skin_tone.json baked before the bust: the fade and the neck plane it was measured from
+NECK_FADE = {"fade_mm": 45.0, "darkest": 0.28, "point": (0.0, -0.123495, 0.058925),
+             "normal": (0.0, 0.977323, 0.211753)}
+AO_DIRECTIONS = 96
+
+
+def seam_loop(vertices: np.ndarray, triangles: np.ndarray, skin: tuple[int, int]) -> np.ndarray:
+    """The skin's one boundary loop ``(S,) int64``, ordered by angle about the neck (front
+    first, turning toward the face's left)."""
+    lo, hi = skin
+    tris = triangles[(triangles >= lo).all(1) & (triangles < hi).all(1)]
+    edges = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), 1)
+    uniq, counts = np.unique(edges, axis=0, return_counts=True)
+    ids = np.unique(uniq[counts == 1])
+    p = vertices[ids]
+    centre_z = p[:, 2].mean()
+    angle = np.mod(np.arctan2(p[:, 0], p[:, 2] - centre_z), 2 * np.pi)
+    return ids[np.argsort(angle)]
+
+
+def superellipse_radius(theta: np.ndarray, a: float, b: float, n: float) -> np.ndarray:
+    """Radius of ``|x/a|^n + |z/b|^n = 1`` along angle ``theta`` from +z toward +x."""
+    s, c = np.abs(np.sin(theta)), np.abs(np.cos(theta))
+    return (np.power(s / a, n) + np.power(c / b, n)) ** (-1.0 / n)
+
+
+def ring_points(loop: np.ndarray) -> np.ndarray:
+    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``RINGS``."""
+    centre = np.array([0.0, 0.0, loop[:, 2].mean()])
+    rel = loop - centre
+    theta = np.arctan2(rel[:, 0], rel[:, 2])
+    r_loop = np.hypot(rel[:, 0], rel[:, 2])
+    out = [loop]
+    for k, (y, tilt, a, b, n, ring_z) in enumerate(RINGS):
+        r = superellipse_radius(theta, a, b, n)
+        zc = ring_z
+        if k < len(LOOP_SHAPE):
+            w = LOOP_SHAPE[k]
+            r = w * r_loop + (1 - w) * r
+            zc = w * centre[2] + (1 - w) * ring_z
+        heights = y + tilt * np.cos(theta)
+        out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
+    return np.array(out)
+
+
+def surface(controls: np.ndarray) -> CubicSpline:
+    """The bust surface as a spline in ring index (0 = the loop) per column."""
+    return CubicSpline(np.arange(len(controls)), controls, axis=0, bc_type="natural")
+
+
+def quads(rows: np.ndarray) -> np.ndarray:
+    """Triangles ``(2 (K-1) S, 3)`` joining consecutive rows of a closed grid of ids ``(K, S)``."""
+    a, b = rows[:-1], np.roll(rows[:-1], -1, axis=1)
+    c, d = rows[1:], np.roll(rows[1:], -1, axis=1)
+    return np.concatenate([np.stack([a, c, b], -1).reshape(-1, 3),
+                           np.stack([b, c, d], -1).reshape(-1, 3)])
+
+
+def outward(vertices: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """``tris`` wound so that their normals point away from the body's vertical axis."""
+    a, b, c = (vertices[tris[:, k]] for k in range(3))
+    n = np.cross(b - a, c - a)
+    radial = (a + b + c) / 3
+    radial[:, 1] = 0
+    return tris if np.einsum("ij,ij->", n, radial) > 0 else tris[:, ::-1].copy()
+
+
+def garment(spline: CubicSpline, theta: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Garment vertices ``(G, 3)``, local triangles and a collar flag ``(G,)``."""
+    start = NECKLINE[0] + NECKLINE[1] * np.clip(np.cos(theta), 0, None) ** 2
+    end = float(len(RINGS))
+    tuck, rib, rib_h = COLLAR
+    rows = [(start, tuck, True), (start, rib, True), (start + rib_h, rib, True)]
+    rows.extend((start + rib_h + s ** 1.6 * (end - start - rib_h), GARMENT_OFFSET, False)
+                for s in np.linspace(0, 1, 22)[1:])
+    verts, flags = [], []
+    columns = np.arange(len(theta))
+    for ks, offset, collar in rows:
+        p = spline(ks)[columns, columns]  # each column at its own ring index
+        d_k = spline(ks, 1)[columns, columns]
+        d_t = np.roll(p, -1, axis=0) - np.roll(p, 1, axis=0)
+        n = np.cross(d_k, d_t)
+        radial = p * [1, 0, 1]
+        n *= np.sign(np.einsum("ij,ij->i", n, radial))[:, None]
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        verts.append(p + offset * n)
+        flags.append(np.full(len(theta), collar))
+    ids = np.arange(len(rows) * len(theta)).reshape(len(rows), len(theta))
+    return np.concatenate(verts), quads(ids), np.concatenate(flags)
+
+
+def unfade(colours: np.ndarray, vertices: np.ndarray, skin: tuple[int, int]) -> np.ndarray:
+    """The head's colours with the old neck fade toward the cut divided out, if it is there
+    (the loop much darker than the neck 5 cm up), else unchanged."""
+    lo, hi = skin
+    point, normal = np.asarray(NECK_FADE["point"]), np.asarray(NECK_FADE["normal"])
+    normal = normal / np.linalg.norm(normal)
+    height = (vertices[lo:hi] - point) @ normal
+    lum = colours[lo:hi].astype(float).mean(1)
+    low, high = lum[height < 0.004].mean(), lum[(height > 0.045) & (height < 0.06)].mean()
+    if low > 0.6 * high:
+        return colours
+    t = np.clip(height / (NECK_FADE["fade_mm"] / 1000.0), 0.0, 1.0)
+    factor = NECK_FADE["darkest"] + (1.0 - NECK_FADE["darkest"]) * t * t * (3 - 2 * t)
+    out = colours.astype(float)
+    out[lo:hi] /= factor[:, None]
+    return np.clip(np.round(out), 0, 255).astype(np.uint8)
+
+
+def bake_ao(head_v: np.ndarray, head_t: np.ndarray, bust_v: np.ndarray,
+            bust_t: np.ndarray) -> np.ndarray:
+    """``(B,)`` ambient occlusion of the bust's vertices, head and bust seen together."""
+    sys.path.insert(0, str(ROOT / "tools"))
+    sys.path.insert(0, str(ROOT))
+    import bake_head_look as bake
+
+    from facelib.rendering.scene import vertex_normals
+
+    vertices = np.concatenate([head_v, bust_v]).astype(np.float64)
+    triangles = np.concatenate([head_t, bust_t])
+    normals = vertex_normals(vertices, triangles).astype(np.float64)
+    directions = bake.sphere_directions(AO_DIRECTIONS)
+    seen = bake.visibility(vertices, triangles, normals, directions)[len(head_v):]
+    weight = np.clip(normals[len(head_v):] @ directions.T, 0.0, None)
+    ao = (seen * weight).sum(1) / np.maximum(weight.sum(1), 1e-9)
+    return np.clip(ao, 0.0, 1.0)
+
+
+def build() -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The bust's arrays and the head's (possibly unfaded) vertex colours."""
+    doc = json.loads((HEAD / "default_head.json").read_text())
+    with np.load(HEAD / "default_head.npz") as data:
+        head_v, head_t = data["vertices"], data["triangles"]
+        head_c, head_ao = data["vertex_colors"], data["vertex_ao"]
+    skin = tuple(doc["parts"]["skin"])
+    head_c = unfade(head_c, head_v, skin)
+    loop_ids = seam_loop(head_v, head_t, skin)
+    loop = head_v[loop_ids].astype(np.float64)
+    theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
+    spline = surface(ring_points(loop))
+    base, n_cols = len(head_v), len(loop_ids)
+    skin_v = spline(SAMPLES).reshape(-1, 3)
+    rows = np.vstack([loop_ids, base + np.arange(skin_v.shape[0]).reshape(len(SAMPLES), n_cols)])
+    all_v = np.concatenate([head_v, skin_v])
+    skin_t = outward(all_v, quads(rows))
+    g_v, g_t, collar = garment(spline, theta)
+    start = base + len(skin_v)
+    g_t = outward(np.concatenate([all_v, g_v]), g_t + start)
+    vertices = np.concatenate([skin_v, g_v]).astype(np.float32)
+    triangles = np.concatenate([skin_t, g_t]).astype(np.int32)
+    # colours: each column continues its loop vertex's skin colour, toward the loop's mean
+    loop_rgb = head_c[loop_ids].astype(float)
+    fall = np.clip(SAMPLES / 4.0, 0, 1)[:, None, None]
+    skin_rgb = (1 - fall) * loop_rgb[None] + fall * loop_rgb.mean(0)
+    g_rgb = np.where(collar[:, None], COLLAR_RGB, GARMENT_RGB) * 255
+    colours = np.concatenate([skin_rgb.reshape(-1, 3), g_rgb])
+    ao = bake_ao(head_v, head_t, vertices, triangles)
+    # the head's own occlusion at the seam carries on down the neck, blending into the bake
+    skin_ao = ao[:len(skin_v)].reshape(len(SAMPLES), n_cols)
+    blend = np.clip(SAMPLES / 3.0, 0, 1)[:, None]
+    skin_ao[:] = (1 - blend) * (head_ao[loop_ids] / 255.0)[None] + blend * skin_ao
+    arrays = {"vertices": vertices, "triangles": triangles,
+              "vertex_colors": np.clip(np.round(colours), 0, 255).astype(np.uint8),
+              "vertex_ao": np.round(ao * 255).astype(np.uint8),
+              "base": np.array(base, np.int64), "seam": loop_ids.astype(np.int32),
+              "seam_vertices": head_v[loop_ids].astype(np.float32),
+              "garment_start": np.array(len(skin_v), np.int64)}
+    return arrays, head_c
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="build and report only")
+    args = parser.parse_args()
+    arrays, head_colours = build()
+    v = arrays["vertices"]
+    print(f"bust: {len(v)} vertices ({int(arrays['garment_start'])} skin), "
+          f"{len(arrays['triangles'])} triangles, y {v[:, 1].min():.3f}..{v[:, 1].max():.3f}, "
+          f"ao {arrays['vertex_ao'].min()}..{arrays['vertex_ao'].max()}")
+    if args.check:
+        return
+    np.savez_compressed(OUT, **arrays)
+    with np.load(HEAD / "default_head.npz") as data:
+        head = {k: data[k] for k in data.files}
+    if not np.array_equal(head["vertex_colors"], head_colours):
+        head["vertex_colors"] = head_colours
+        np.savez_compressed(HEAD / "default_head.npz", **head)
+        print("undid the neck fade of default_head.npz's skin colours")
+    print(f"wrote {OUT.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
