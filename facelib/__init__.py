@@ -37,6 +37,7 @@ from facelib.errors import (
     facelib_warnings,
 )
 from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
+from facelib.visemes import visemes_from_audio
 
 if TYPE_CHECKING:
     from facelib.engine import Face, load_face
@@ -132,6 +133,7 @@ __all__ = [
     "track_video_faps",
     "view",
     "visemes",
+    "visemes_from_audio",
     "write_face",
     "write_fap",
 ]

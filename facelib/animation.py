@@ -147,6 +147,31 @@ def _animate(
     )
 
 
+def _expression_track(storyboard: Storyboard, n_frames: int,
+                      rules: SyncRules) -> tuple[FapTrack, expressions.MoodCurves | None]:
+    """The expression track with the storyboard's moods blended under it, and the moods."""
+    fps = storyboard.fps
+    library = expressions.default_library().with_defs(
+        storyboard.expression_defs, mixes=storyboard.expression_mixes)
+    moods = (expressions.mood_curves(storyboard.moods, fps=fps, n_frames=n_frames,
+                                     library=library) if storyboard.moods else None)
+    track = expressions.animate(storyboard.expressions, fps=fps, n_frames=n_frames,
+                                library=library, importance=rules.expression_importance,
+                                moods=moods)
+    return track, moods
+
+
+def _with_mood(lively: Liveliness, moods: expressions.MoodCurves | None) -> Liveliness:
+    """``lively`` with the moods' idle amplitude on the micro-movements and their head
+    motion on the listening head motion, frame by frame (unchanged without moods)."""
+    if moods is None:
+        return lively
+    return replace(
+        lively,
+        micro_amplitude=lively.micro_amplitude * moods.scales["idle_amplitude"],
+        listening_amplitude=lively.listening_amplitude * moods.scales["head_motion_scale"])
+
+
 def compose(
     storyboard: Storyboard, *, visemes: FapTrack | None, speaking: np.ndarray | None,
     n_frames: int, rules: SyncRules, report: Callable[[int], None] | None = None,
@@ -170,13 +195,8 @@ def compose(
         viseme_track = visemes.padded(n_frames)
     if speaking is not None:
         talking[: speaking.size] = speaking[:n_frames]
-    expression_track = expressions.animate(
-        storyboard.expressions, fps=fps, n_frames=n_frames,
-        library=expressions.default_library().with_defs(
-            storyboard.expression_defs, mixes=storyboard.expression_mixes
-        ),
-        importance=rules.expression_importance,
-    )
+    expression_track, moods = _expression_track(storyboard, n_frames, rules)
+    lively = _with_mood(lively, moods)
     if report is not None:
         report(1)
     eyes = gaze.animate(storyboard.gaze, fps=fps, n_frames=n_frames, seed=storyboard.seed,
@@ -186,7 +206,9 @@ def compose(
         report(2)
     stream = combine(expressions=expression_track, visemes=viseme_track, gaze=eyes.open_track,
                      blinks=eyes.lid_closure, blink_lids=eyes.blink_lids, speaking=talking,
-                     rules=rules, seed=storyboard.seed, liveliness=lively)
+                     rules=rules, seed=storyboard.seed, liveliness=lively,
+                     head_scale=None if moods is None else moods.scales["head_motion_scale"],
+                     speech_brow=None if moods is None else moods.scales["speech_brow"])
     if report is not None:
         report(3)
     tracks = {"expressions": expression_track, "visemes": viseme_track, "gaze": eyes.track}

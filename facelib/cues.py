@@ -14,8 +14,8 @@ from types import MappingProxyType
 from typing import Any
 
 __all__ = [
-    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "CameraCue", "ExpressionCue", "GazeCue", "Origin",
-    "SpeechSpec", "Storyboard", "VisemeCue",
+    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "CameraCue", "ExpressionCue", "GazeCue", "MoodCue",
+    "Origin", "SpeechSpec", "Storyboard", "VisemeCue",
 ]
 
 MAX_FRAMES = 360_000
@@ -47,6 +47,22 @@ class ExpressionCue:
     @property
     def end_ms(self) -> int:
         return self.start_ms + self.duration_ms
+
+
+@dataclass(frozen=True, slots=True)
+class MoodCue:
+    """From ``start_ms`` on, the character is in mood ``name`` (a row of
+    ``facelib/data/moods/moods.csv``) at ``intensity`` (0-1), until the next mood cue.
+
+    The face eases into it over ``ease_ms`` (None: the mood's own ``ease_ms``), crossfading
+    from the mood before.
+    """
+
+    name: str
+    start_ms: int
+    intensity: float = 1.0
+    ease_ms: int | None = None
+    origin: Origin | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,6 +163,7 @@ class Storyboard:
     language: the storyboard's language (``language = "pt"``), used by speech that names
         none; None means English.
     camera: the camera cues, in time order (the renderer re-frames at each).
+    moods: the mood cues, in time order (each lasts until the next).
     """
 
     path: Path | None = None
@@ -162,6 +179,7 @@ class Storyboard:
     face: Path | None = None
     language: str | None = None
     camera: tuple[CameraCue, ...] = ()
+    moods: tuple[MoodCue, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
@@ -170,9 +188,11 @@ class Storyboard:
 
     @property
     def cues_end_ms(self) -> int:
-        """End of the last expression, gaze, camera or stored-viseme cue (speech audio may
-        last longer; the animation pipeline takes the longest track)."""
+        """End of the last expression, gaze, camera or stored-viseme cue, or start of the
+        last mood (speech audio may last longer; the animation pipeline takes the longest
+        track)."""
         ends = [c.end_ms for c in self.expressions] + [c.end_ms for c in self.gaze]
+        ends += [c.start_ms for c in self.moods]
         ends += [c.end_ms for c in self.camera]
         if self.speech is not None and self.speech.visemes:
             ends += [c.end_ms for c in self.speech.visemes]

@@ -868,7 +868,7 @@ def learned_fields(pos, fp, *, skin_target, n_skin):
 
 def expression_mixes(*, skin_target, n_skin):
     """``mix_<expression>``: (n_skin, 3) float32 skin displacement (metres) of each mix of
-    expression_mixes.csv, the references that tools/fit_expressions.py fits FAPs to."""
+    expression_mixes.csv, the references tests/engine/test_engine_target_mixes.py compares with."""
     path = ROOT / "facelib" / "data" / "head" / "expression_mixes.csv"
     lines = [ln for ln in path.read_text("utf-8").splitlines() if not ln.startswith("#")]
     mixes: dict[str, np.ndarray] = {}

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from facelib.cli.console import EXIT_OK, Console, UsageError
+from facelib.cli.console import EXIT_OK, Console
 from facelib.cli.options import COMMON
 from facelib.cli.outputs import STDOUT, check_suffix, emit_text
 from facelib.errors import FileError
@@ -17,7 +17,8 @@ def add(commands: Any) -> None:
     align = commands.add_parser("align", help="align speech audio to visemes",
                                 parents=[COMMON])
     align.add_argument("audio", help="speech audio (any format soundfile reads)")
-    align.add_argument("--text", help="the transcript (omit for phone-loop recognition)")
+    align.add_argument("--text", help="the transcript (omit it to recognise the speech: "
+                                      "English words, then the phone loop where none is heard)")
     align.add_argument("--text-file", help="a file holding the transcript")
     align.add_argument("-o", "--output", required=True,
                        help="OUT.json, OUT.tsv or OUT.sb; - writes --format to stdout")
@@ -27,13 +28,18 @@ def add(commands: Any) -> None:
     align.add_argument("--lang", default="en",
                        help="language of the speech (en: pocketsphinx; others: DTW against "
                             "espeak-ng, which needs --text)")
+    align.add_argument("--recognize", choices=("auto", "words", "phones"), default="auto",
+                       help="without --text: auto (words decoded then aligned, the phone "
+                            "loop where no word is heard), words (no fallback) or phones "
+                            "(the phone loop alone)")
     align.set_defaults(run=_align)
 
 
 def _align(args: argparse.Namespace, console: Console) -> int:
     import json
 
-    from facelib.visemes import align, align_dtw
+    from facelib.speech.recognize import recognize
+    from facelib.visemes import align, align_dtw, with_visemes
     from facelib.visemes.scripts import (
         timeline_to_json,
         timeline_to_sentence,
@@ -49,10 +55,11 @@ def _align(args: argparse.Namespace, console: Console) -> int:
             text = Path(args.text_file).read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise FileError(f"cannot read the transcript: {exc}", path=args.text_file) from exc
-    if args.lang.lower().startswith("en"):
+    if text is None:
+        timeline = with_visemes(recognize(args.audio, language=args.lang,
+                                          method=args.recognize))
+    elif args.lang.lower().startswith("en"):
         timeline = align(args.audio, text)
-    elif text is None:
-        raise UsageError(f"aligning speech in {args.lang!r} needs its transcript (--text)")
     else:
         timeline = align_dtw(args.audio, text, lang=args.lang)
     formatted = {

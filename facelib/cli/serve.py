@@ -22,6 +22,12 @@ def add(commands: Any) -> None:
                             "(default FACELIB_TOKEN)")
     serve.add_argument("--max-sessions", type=int, default=16,
                        help="sessions at once (default 16)")
+    serve.add_argument("--livelink", metavar="HOST:PORT",
+                       help="also send every session's frames as Live Link Face UDP packets "
+                            "(Unreal's Live Link; port 11111 if left out)")
+    serve.add_argument("--vmc", metavar="HOST:PORT",
+                       help="also send every session's frames as VMC protocol OSC bundles "
+                            "(VSeeFace, VNyan; port 39539 if left out)")
     serve.set_defaults(run=_serve)
 
 
@@ -30,7 +36,8 @@ def _serve(args: argparse.Namespace, console: Console) -> int:
 
     options = ServerOptions(host=args.host, port=args.port,
                             token=os.environ.get(args.token_env) or None,
-                            max_sessions=args.max_sessions)
+                            max_sessions=args.max_sessions, livelink=args.livelink,
+                            vmc=args.vmc)
     print(f"facelib serve: ws://{options.host}:{options.port}"
           f"{' (token required)' if options.token else ''}", flush=True)
     asyncio.run(serve(options))

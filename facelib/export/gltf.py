@@ -18,7 +18,7 @@ import numpy as np
 
 from facelib import data
 from facelib.atomic import atomic_path
-from facelib.engine import Face, default_face, surface
+from facelib.engine import Face, Part, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import ParameterError
 from facelib.export.audio import copy_audio
@@ -29,7 +29,7 @@ from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
 from facelib.optional import require
 
-__all__ = ["GltfExport", "export_gltf"]
+__all__ = ["GltfExport", "export_gltf", "primitive_vertex_ids"]
 
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
 _ARRAY, _ELEMENTS = 34962, 34963
@@ -176,6 +176,17 @@ def _normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return surface.vertex_normals(vertices, triangles, unused=(0.0, 0.0, 1.0)).astype(np.float32)
 
 
+def primitive_vertex_ids(part: Part) -> np.ndarray:
+    """The face vertex each vertex of ``part``'s primitive is, ``(Vq,) int64``: the part's
+    own vertices (sorted), then those of other parts that its triangles use (sorted; the
+    bust's first triangles use the head's neck loop). A primitive's indices can only name
+    its own vertices, so those are copied into it with all their attributes and targets,
+    and the copies move as the originals do."""
+    own = np.sort(part.vertex_ids.astype(np.int64))
+    used = np.unique(part.triangles.astype(np.int64))
+    return np.concatenate([own, np.setdiff1d(used, own, assume_unique=True)])
+
+
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
     """One primitive per part; ``targets`` (T, V, 3) float32 displacements."""
     lib = b.lib
@@ -192,7 +203,7 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     weights[:, :2] = rig.weights
     out = []
     for name, part in face.parts.items():
-        ids = np.sort(part.vertex_ids.astype(np.int64))
+        ids = primitive_vertex_ids(part)
         local = np.full(face.n_vertices, -1, np.int64)
         local[ids] = np.arange(len(ids))
         tris = local[part.triangles].astype(np.uint16 if len(ids) < 65536 else np.uint32)

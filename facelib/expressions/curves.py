@@ -13,6 +13,7 @@ from facelib.checks import check_count, check_fps, check_items
 from facelib.cues import ExpressionCue
 from facelib.errors import DataError, FdlError, ParameterError
 from facelib.expressions.library import ExpressionLibrary, default_library
+from facelib.expressions.moods import MoodCurves
 from facelib.mpeg4.tables import N_FAPS
 from facelib.mpeg4.track import FapTrack
 
@@ -85,17 +86,23 @@ def animate(
     library: ExpressionLibrary | None = None,
     importance: Mapping[str, float] | None = None,
     easing: Easing = "linear",
+    moods: MoodCurves | None = None,
 ) -> FapTrack:
     """The expression track of a storyboard.
 
-    Each cue contributes ``envelope * intensity * expression`` to the FAPs its expression
-    drives. Where cues overlap, the values are averaged with their envelopes as weights
-    once the envelopes add up to more than 1, so two full expressions blend half and half
-    and a fading one hands over smoothly. Between cues the face is neutral.
+    Each cue contributes ``envelope * share(intensity) * expression`` to the FAPs its
+    expression drives (``share``: the expression's intensity curve, ``intensity.csv``).
+    Where cues overlap, the values are averaged with their envelopes as weights once the
+    envelopes add up to more than 1, so two full expressions blend half and half and a
+    fading one hands over smoothly. Between cues the face is neutral.
 
     The track's weight on a FAP is the summed envelope (at most 1) times the expression's
     ``importance`` (name -> [0, 1], default 1), which the synchronizer uses to blend the
     expressions against visemes and gaze.
+
+    moods: the storyboard's mood baseline (:func:`facelib.expressions.moods.mood_curves`),
+    or None. It shows where no expression drives a FAP and blends under the explicit ones:
+    ``explicit + (1 - s) * baseline`` with ``s`` the summed envelopes on that FAP (at most 1).
 
     Returns a :class:`FapTrack` of ``n_frames`` at ``fps``. Each cue touches only the frames
     of its own span (its envelope is 0 elsewhere), so time grows linearly with the length
@@ -119,8 +126,21 @@ def animate(
                      int(np.searchsorted(times, cue.end_ms, side="right")))
         e = envelope(times[span], start_ms=cue.start_ms, duration_ms=cue.duration_ms,
                      ramp_in_ms=ramp_in, ramp_out_ms=ramp_out, easing=easing)[:, None]
-        total[span] += e * cue.intensity * expression.values
+        total[span] += e * expression.share(cue.intensity) * expression.values
         strength[span] += e * expression.mask
         weight[span] += e * expression.mask * float(importance.get(expression.name, 1.0))
     values = total / np.maximum(strength, 1.0)
+    if moods is not None:
+        values, weight = _under(moods, values, weight, strength)
     return FapTrack(fps, values.astype(np.float32), np.clip(weight, 0.0, 1.0).astype(np.float32))
+
+
+def _under(moods: MoodCurves, values: np.ndarray, weight: np.ndarray,
+           strength: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The mood baseline blended under the explicit expressions' ``values`` and ``weight``
+    (``(n_frames, 84)``), uncovered where their summed envelopes ``strength`` are below 1."""
+    if moods.values.shape != values.shape:
+        raise ParameterError(f"moods cover {moods.values.shape[0]} frames; the expression "
+                             f"track has {values.shape[0]}")
+    free = 1.0 - np.clip(strength, 0.0, 1.0)
+    return values + free * moods.values, weight + free * moods.mask

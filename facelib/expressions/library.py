@@ -1,8 +1,10 @@
 """The expression library: named sets of FAP values at full intensity.
 
-The default library is ``facelib/data/expressions.csv`` (one row per expression and FAP,
-with a note on where each value comes from). Storyboards add or override expressions with
-``Storyboard.expression_defs``.
+The default library is built from FACS action units: ``facelib/data/expressions/`` holds
+the units' FAP amplitudes (``action_units.csv``), each expression as a combination of units
+(``expressions.csv``, with a note on every part) and each expression's intensity curve
+(``intensity.csv``); :mod:`facelib.mpeg4.action_units` composes them. Storyboards add or
+override expressions with ``Storyboard.expression_defs``.
 """
 
 from __future__ import annotations
@@ -14,10 +16,10 @@ from types import MappingProxyType
 
 import numpy as np
 
-from facelib import data
 from facelib.checks import did_you_mean
 from facelib.cues import Origin
-from facelib.errors import DataError, FdlError, ParameterError
+from facelib.errors import FdlError, ParameterError
+from facelib.mpeg4.action_units import compose, intensity_exponents, recipes
 from facelib.mpeg4.tables import N_FAPS, fap
 
 __all__ = ["Expression", "ExpressionLibrary", "default_library"]
@@ -32,11 +34,21 @@ class Expression:
 
     values: ``(84,) float32`` FAP values in FAP units (0 where the expression is silent).
     mask: ``(84,) bool``, the FAPs the expression drives.
+    exponent: its intensity curve, ``share = intensity ** exponent`` (1: linear).
+    parts: the action units (``("AU4", 1.0)``) and FAPs it is made of; empty for an
+        expression given as FAP values.
     """
 
     name: str
     values: np.ndarray
     mask: np.ndarray
+    exponent: float = 1.0
+    parts: tuple[tuple[str, float], ...] = ()
+
+    def share(self, intensity: float) -> float:
+        """The share of the full FAP values shown at cue ``intensity``: its intensity curve,
+        mirrored for negative intensities (0.6 ** 0.6 = 0.74 with an exponent of 0.6)."""
+        return float(np.sign(intensity) * abs(intensity) ** self.exponent)
 
     @classmethod
     def from_faps(cls, name: str, faps: FapValues) -> Expression:
@@ -120,15 +132,13 @@ class ExpressionLibrary:
 
 @cache
 def default_library() -> ExpressionLibrary:
-    """The expressions shipped with facelib (read once)."""
-    table: dict[str, dict[str | int, float]] = {}
-    for line, row in data.csv_rows("expressions.csv"):
-        try:
-            value = float(row["value"])
-        except ValueError:
-            raise DataError(f"value {row['value']!r} is not a number",
-                            path=str(data.path("expressions.csv")), line=line) from None
-        table.setdefault(row["expression"], {})[row["fap"]] = value
-    return ExpressionLibrary(
-        MappingProxyType({name: Expression.from_faps(name, faps) for name, faps in table.items()})
-    )
+    """The expressions shipped with facelib, composed from their action units (read once)."""
+    exponents = intensity_exponents()
+    out = {}
+    for name, recipe in recipes().items():
+        values, mask = compose(recipe.parts)
+        values32 = values.astype(np.float32)
+        values32.flags.writeable = False
+        mask.flags.writeable = False
+        out[name] = Expression(name, values32, mask, exponents.get(name, 1.0), recipe.parts)
+    return ExpressionLibrary(MappingProxyType(out))

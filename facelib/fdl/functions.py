@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from facelib.errors import FdlError
-from facelib.fdl import camera, modern
+from facelib.fdl import camera, modern, moods
 from facelib.fdl.context import Context
 from facelib.fdl.thesis import SCRIPT_GLOBALS
 
@@ -71,6 +71,10 @@ FUNCTIONS: Mapping[str, StoryboardFunction] = MappingProxyType({
         StoryboardFunction(
             "camera", ("framing", "at", "dur"),
             'camera { framing = "head", at = 2, dur = 0.5 }', camera.read_camera,
+        ),
+        StoryboardFunction(
+            "mood", ("at", "intensity", "ease"),
+            'mood { "happy", at = 2, intensity = 0.6 }', moods.read_mood,
         ),
         StoryboardFunction(
             "define_expression", None, 'define_expression { "smirk", raise_l_cornerlip = 120 }',

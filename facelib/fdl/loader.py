@@ -27,6 +27,7 @@ from facelib.fdl.camera import camera_cues
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.functions import SETTINGS, function_names, known_globals, read_calls
 from facelib.fdl.modern import ModernParts
+from facelib.fdl.moods import mood_cues
 from facelib.fdl.paths import read_text, resolve_inside
 from facelib.fdl.sandbox import WHITELIST, ChunkResult, Sandbox
 from facelib.fdl.thesis import SCRIPT_GLOBALS, check_fdl_table
@@ -220,6 +221,7 @@ def _build(
         expression_mixes=parts.expression_mixes,
         face=face,
         camera=camera_cues(parts.camera, ctx),
+        moods=mood_cues(parts.moods, ctx),
     )
 
 

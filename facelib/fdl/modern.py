@@ -85,6 +85,7 @@ class ModernParts:
     expression_mixes: dict[str, Mapping[str, float]] = field(default_factory=dict)
     gaze_defs: dict[str, Mapping[str, Any]] = field(default_factory=dict)
     camera: list[DraftCue] = field(default_factory=list)
+    moods: list[DraftCue] = field(default_factory=list)
 
 
 def table_of(

@@ -8,10 +8,12 @@ behaviours with plain mappings of the same shape (see ``docs/gaze.md``).
 from __future__ import annotations
 
 import copy
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
+from types import MappingProxyType
 from typing import Any
 
 from facelib import data
@@ -52,13 +54,25 @@ def _library_json() -> dict[str, Any]:
     return library
 
 
+@cache
+def _library_text() -> str:
+    return json.dumps(_library_json())
+
+
 def behaviour_library() -> dict[str, dict[str, Any]]:
-    """A fresh copy of the built-in behaviours: name -> {description, args, params}."""
-    return {k: copy.deepcopy(v) for k, v in _library_json().items()}
+    """A fresh copy of the built-in behaviours: name -> {description, args, params} (parsed
+    anew from the cached JSON text: several times quicker than a deep copy)."""
+    library: dict[str, dict[str, Any]] = json.loads(_library_text())
+    return library
 
 
-def _direction_names() -> dict[str, float | None]:
-    return dict(data.json_data("gaze/directions.json")["directions"])
+@cache
+def _directions() -> Mapping[str, float | None]:
+    return MappingProxyType(dict(data.json_data("gaze/directions.json")["directions"]))
+
+
+def _direction_names() -> Mapping[str, float | None]:
+    return _directions()
 
 
 DIRECTION_NAMES = tuple(_direction_names())

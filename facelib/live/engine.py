@@ -34,7 +34,7 @@ from facelib.visemes.timeline import SpeechTimeline
 
 __all__ = ["Engine", "Frame"]
 
-_AHEAD_S = 1.0
+_AHEAD_S = 3.0
 """How far past the requested frame a window is computed (s): one recomputation serves
 this many frames when no input comes."""
 
@@ -176,6 +176,30 @@ class Engine:
             out.append(self._frame(self.committed))
             self.committed += 1
         return out
+
+    def wanted(self, *, margin_s: float) -> tuple[Plan, int] | None:
+        """``(plan, n_frames)`` of the window the current epoch needs before ``margin_s``
+        more seconds of frames go out (None: the one it has lasts): a session computes it
+        ahead, off its clock (:func:`facelib.live.plan.window`), and :meth:`offer` s it."""
+        e = self._epoch
+        local = self.committed - e.start
+        if e.window is not None and e.window.n_frames - local > margin_s * self.fps:
+            return None
+        return e.plan, local + 1 + round(_AHEAD_S * self.fps)
+
+    def offer(self, plan: Plan, computed: Window) -> None:
+        """Use ``computed`` (``window(plan, ...)``) if ``plan`` is still the epoch's and it
+        reaches further than the window held; else drop it. The frames are the same as
+        those :meth:`advance` would compute itself (the window is a pure function)."""
+        e = self._epoch
+        if e.plan is plan and (e.window is None or computed.n_frames > e.window.n_frames):
+            e.window = computed
+
+    def covers(self, until_ms: float) -> bool:
+        """Whether the window held has every frame before ``until_ms`` (no epoch starts)."""
+        e = self._epoch
+        last = math.ceil(until_ms * self.fps / 1000 - 1e-9) - 1 - e.start
+        return e.window is not None and last < e.window.n_frames
 
     def _rows(self, epoch: _Epoch, index: int) -> tuple[np.ndarray, np.ndarray, int, bool]:
         local = index - epoch.start

@@ -47,27 +47,32 @@ class Listener:
     def __init__(self) -> None:
         self._decoder: Any = None
         self._chunks: list[np.ndarray] = []
+        self._open = False  # an utterance is started
         self.n_samples = 0
 
     @property
     def duration_ms(self) -> int:
         return self.n_samples * 1000 // ALIGN_RATE
 
-    def _start(self) -> None:
+    def prepare(self) -> None:
+        """Load the recognizer (about 0.6 s and 90 MB) and open the next stretch's utterance
+        (its leading pad decoded) now, rather than at the first samples."""
         if self._decoder is None:
-            self._decoder = _decoder()
-            self._decoder.activate_search(_PHONE_LOOP)
-        self._decoder.start_utt()
-        pad = alignment_settings()["pad_ms"]
-        self._decoder.process_raw(to_pcm16(np.zeros(0, np.float32), pad_ms=pad // 2),
-                                  no_search=False, full_utt=False)
+            decoder = _decoder()
+            decoder.activate_search(_PHONE_LOOP)
+            self._decoder = decoder
+        if not self._open:
+            self._decoder.start_utt()
+            pad = alignment_settings()["pad_ms"]
+            self._decoder.process_raw(to_pcm16(np.zeros(0, np.float32), pad_ms=pad // 2),
+                                      no_search=False, full_utt=False)
+            self._open = True
 
     def feed(self, samples: np.ndarray) -> tuple[SpeechTimeline, SpeechAudio]:
         """Add ``samples`` (``(n,) float32`` at 16 kHz) to the stretch: its timeline so far
         (phones of the phone loop, their visemes; the last may still change) and its
         samples from the first."""
-        if not self._chunks:
-            self._start()
+        self.prepare()
         self._chunks.append(np.asarray(samples, np.float32))
         self.n_samples += samples.size
         pcm = np.clip(np.round(samples.astype(np.float64) * 32767), -32768, 32767)
@@ -104,7 +109,8 @@ class Listener:
 
     def end(self) -> None:
         """End the stretch: the next samples start a new one."""
-        if self._chunks:
+        if self._open:
             self._decoder.end_utt()
+            self._open = False
         self._chunks = []
         self.n_samples = 0

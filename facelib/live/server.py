@@ -31,6 +31,7 @@ from typing import Any
 
 from facelib.errors import FacelibError, ParameterError
 from facelib.live.session import OUTPUT_RATE, Output, Session
+from facelib.live.udp import parse_target
 from facelib.optional import require
 
 __all__ = ["HARD_MESSAGE_BYTES", "MAX_MESSAGE_BYTES", "ServerOptions", "frame_message",
@@ -43,19 +44,25 @@ MAX_MESSAGE_BYTES = 256 * 1024
 HARD_MESSAGE_BYTES = 1024 * 1024
 """Largest message the WebSocket layer accepts at all (it closes the connection, code 1009)."""
 _OUTPUTS = {"faps", "arkit", "visemes"}
+_SESSION_KEYS = ("fps", "lookahead_ms", "seed", "lang", "voice", "rate", "clock", "face",
+                 "audio_in", "subject")
 _START_KEYS = {"type", "token", "fps", "lookahead_ms", "seed", "lang", "voice", "rate",
-               "outputs", "clock", "face"}
+               "outputs", "clock", "face", "audio_in", "livelink", "vmc", "subject"}
 
 
 @dataclass(frozen=True)
 class ServerOptions:
     """Where and how the server listens: ``host``, ``port``, ``token`` (required unless the
-    host is a loopback address), ``max_sessions`` at once."""
+    host is a loopback address), ``max_sessions`` at once; ``livelink`` / ``vmc``:
+    ``HOST:PORT`` every session's frames also go to (any host: the operator names it; a
+    ``start`` message may name a loopback one for its own session)."""
 
     host: str = "127.0.0.1"
     port: int = 8765
     token: str | None = None
     max_sessions: int = 16
+    livelink: str | None = None
+    vmc: str | None = None
 
     def __post_init__(self) -> None:
         if not _is_loopback(self.host) and not self.token:
@@ -110,8 +117,15 @@ def _session_from(start: dict[str, Any], options: ServerOptions) -> tuple[Sessio
     outputs = start.get("outputs", ["faps", "visemes"])
     if not isinstance(outputs, list) or not outputs or not set(outputs) <= _OUTPUTS:
         raise ParameterError(f"start: outputs must be a list from {sorted(_OUTPUTS)}")
-    kwargs = {k: start[k] for k in ("fps", "lookahead_ms", "seed", "lang", "voice", "rate",
-                                    "clock", "face") if k in start}
+    if not isinstance(start.get("audio_in", False), bool):
+        raise ParameterError("start: audio_in must be true or false")
+    kwargs: dict[str, Any] = {k: start[k] for k in _SESSION_KEYS if k in start}
+    for kind, port in (("livelink", 11111), ("vmc", 39539)):
+        if start.get(kind) is not None:  # a client may only name loopback targets
+            parse_target(start[kind], default_port=port, loopback_only=True)
+            kwargs[kind] = start[kind]
+        elif getattr(options, kind) is not None:
+            kwargs[kind] = getattr(options, kind)
     return Session(arkit="arkit" in outputs, **kwargs), set(outputs)
 
 

@@ -10,21 +10,22 @@ FAP 2 (expression) selects two of the six standard expressions (1 joy, 2 sadness
     expression = intensity1 / 63 * E[select1] + intensity2 / 63 * E[select2]
 
 ``V`` and ``E`` are the FAP values of facelib's viseme table
-(``facelib/data/visemes/viseme_faps.json``) and expression library
-(``facelib/data/expressions.csv``) at full intensity. The viseme and the expression add up;
+(``facelib/data/visemes/viseme_faps.json``) and expression library (composed from its
+action units, :mod:`facelib.mpeg4.action_units`) at full intensity. The viseme and the
+expression add up;
 a low-level FAP that the frame sets itself keeps its own value (the file's author animated
 it explicitly), every other FAP takes the decoded value.
 """
 
 from __future__ import annotations
 
-import csv
 from functools import cache
 
 import numpy as np
 
 from facelib import data
 from facelib.errors import DataError
+from facelib.mpeg4.action_units import compose, recipes
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import N_FAPS, fap
 from facelib.mpeg4.visemes import N_VISEMES, viseme_names
@@ -55,16 +56,12 @@ def viseme_table() -> np.ndarray:
 def expression_table() -> np.ndarray:
     """(7, 84) float32: FAP values of each FAP 2 expression id (row 0 neutral: zeros)."""
     out = np.zeros((len(EXPRESSION_IDS), N_FAPS), np.float32)
-    # the notes column holds commas, so only the first three cells are read
-    for line, raw in enumerate(data.text("expressions.csv").splitlines(), start=1):
-        cells = next(csv.reader([raw]), [])
-        if not cells or raw.startswith("#") or cells[0] not in EXPRESSION_IDS:
-            continue
-        try:
-            out[EXPRESSION_IDS.index(cells[0]), fap(cells[1]).index] = float(cells[2])
-        except (ValueError, IndexError) as exc:
-            raise DataError(f"bad row: {exc}", path=str(data.path("expressions.csv")),
-                            line=line) from None
+    table = recipes()
+    for i, name in enumerate(EXPRESSION_IDS[1:], start=1):
+        if name not in table:
+            raise DataError(f"expression {name!r} is missing",
+                            path=str(data.path("expressions/expressions.csv")))
+        out[i] = compose(table[name].parts)[0]
     out.flags.writeable = False
     return out
 

@@ -62,8 +62,9 @@ def align(
     audio:
         A sound file in any format soundfile reads, or an array (then give ``sample_rate``).
     text:
-        The transcript. With it: forced alignment (``source="forced"``). Without: phone-loop
-        recognition (``source="phone-loop"``, no words; less accurate).
+        The transcript. With it: forced alignment (``source="forced"``). Without: English
+        speech recognised by :func:`facelib.speech.recognize.recognize` (words decoded,
+        then aligned; the phone loop where no word is heard).
     on_implausible:
         What to do when the alignment looks wrong (a phone three times its usual length, a
         word squeezed to the minimum duration, a very poor acoustic score, a pause that
@@ -84,13 +85,14 @@ def align(
         raise ParameterError(
             f"on_implausible must be warn, raise or ignore, not {on_implausible!r}"
         )
+    if text is None:
+        from facelib.speech.recognize import recognize
+
+        return recognize(audio, sample_rate=sample_rate)
     samples = load_speech(audio, sample_rate=sample_rate)
     duration_ms = round(samples.size * 1000 / ALIGN_RATE)
     settings = alignment_settings()
     where = audio if not isinstance(audio, np.ndarray) else None
-    if text is None:
-        phones = _phone_loop(to_pcm16(samples, pad_ms=settings["pad_ms"]), duration_ms)
-        return PhoneTimeline(phones, (), "phone-loop", duration_ms)
     if duration_ms > LONG_MS:
         phones, words, problems, guessed = _forced_in_pieces(samples, text, where)
     else:

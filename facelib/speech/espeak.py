@@ -9,7 +9,9 @@ static variables that neither its seeds nor re-initialisation reset, so within o
 the same text comes out a few ms different from call to call, depending on everything
 spoken before. A freshly loaded library given the same requests in the same order gives the
 same samples and times, bit for bit, so an animation never depends on what the process did
-earlier. It costs one small interpreter start (about 0.1 s) per batch of requests.
+earlier. It costs one small interpreter start (about 0.1 s) per batch of requests; a
+:class:`Worker` started ahead of its request (a live session keeps one spare) has paid it,
+and the library is loaded, by the time the text comes.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from facelib.errors import SpeechError
 from facelib.optional import require
 from facelib.speech import espeak_worker
 
-__all__ = ["EspeakEvent", "EspeakVoice", "RawSynthesis", "default_words_per_minute",
+__all__ = ["EspeakEvent", "EspeakVoice", "RawSynthesis", "Worker", "default_words_per_minute",
            "list_voices", "synth_fresh"]
 
 _DEFAULT_WPM = 175
@@ -72,19 +74,48 @@ def _check_installed() -> None:
     require("espeak")
 
 
-def synth_fresh(requests: Sequence[tuple[str, str, int, int]]) -> list[RawSynthesis]:
+class Worker:
+    """A synthesis process, started now and given its one batch of requests later (by
+    :func:`synth_fresh`): a fresh library either way, so the same result bit for bit, without
+    the wait for the interpreter and the library once the text comes. :meth:`close` ends
+    one that is not used."""
+
+    def __init__(self) -> None:
+        _check_installed()
+        self._process: subprocess.Popen[bytes] | None = subprocess.Popen(
+            [sys.executable, str(Path(espeak_worker.__file__))], stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+    def run(self, payload: bytes) -> tuple[int, bytes, bytes]:
+        """Exit status, stdout and stderr of the worker given ``payload`` (once only)."""
+        process, self._process = self._process, None
+        if process is None:
+            raise SpeechError("an espeak-ng worker speaks one batch of requests only")
+        out, err = process.communicate(payload)
+        return process.returncode, out, err
+
+    def close(self) -> None:
+        """End the process if it has not been used."""
+        process, self._process = self._process, None
+        if process is not None:
+            process.kill()
+            process.communicate()
+
+
+def synth_fresh(requests: Sequence[tuple[str, str, int, int]], *,
+                worker: Worker | None = None) -> list[RawSynthesis]:
     """Each ``(text, voice, words_per_minute, pitch)`` spoken in turn by a freshly loaded
-    libespeak-ng in a new process. ``voice``: a language code or voice identifier
-    (``"+variant"`` allowed); ``words_per_minute`` 80-450; ``pitch`` 0-100 (50: the voice's
-    own). Raises SpeechError for an unknown voice or a failed synthesis."""
+    libespeak-ng in a new process (``worker``, started ahead, or one started now).
+    ``voice``: a language code or voice identifier (``"+variant"`` allowed);
+    ``words_per_minute`` 80-450; ``pitch`` 0-100 (50: the voice's own). Raises SpeechError
+    for an unknown voice or a failed synthesis."""
     _check_installed()
     payload = pickle.dumps([(str(t), str(v), int(w), int(p)) for t, v, w, p in requests])
-    done = subprocess.run([sys.executable, str(Path(espeak_worker.__file__))], input=payload,
-                          capture_output=True, check=False)
-    if done.returncode != 0:
+    code, stdout, stderr = (worker or Worker()).run(payload)
+    if code != 0:
         raise SpeechError("espeak-ng synthesis failed: "
-                          + done.stderr.decode("utf-8", "replace").strip()[-400:])
-    result = pickle.loads(done.stdout)
+                          + stderr.decode("utf-8", "replace").strip()[-400:])
+    result = pickle.loads(stdout)
     if isinstance(result, tuple) and result and result[0] == "error":
         raise SpeechError(str(result[1]))
     out = []

@@ -1,7 +1,8 @@
 """libespeak-ng through ctypes, standalone (standard library and ``espeakng_loader`` only).
 
 :mod:`facelib.speech.espeak` imports it to list voices, and runs it as a script
-(``python .../espeak_worker.py``) to synthesize with a freshly loaded library: it reads a
+(``python .../espeak_worker.py``) to synthesize with a freshly loaded library: it loads the
+library, then reads a
 pickled list of ``(text, voice, words_per_minute, pitch)`` from stdin and writes a pickled
 list of ``(sample_rate, int16 PCM bytes, events)`` (events: ``(kind, name, sample,
 text_position, length)``), or ``("error", message)``, to stdout. Only facelib starts it,
@@ -10,6 +11,7 @@ with its own data. It imports nothing from facelib, so it starts in about 0.1 s.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import pickle
 import sys
@@ -140,6 +142,10 @@ def _languages(address: int | None) -> tuple[str, ...]:
 
 
 def main() -> int:
+    # the library is loaded before the requests are read, so a process started ahead of its
+    # request (facelib.speech.espeak.Worker) has it ready; the result is the same either way
+    with contextlib.suppress(RuntimeError, ImportError):  # reported below, with the requests
+        library()
     requests = pickle.loads(sys.stdin.buffer.read())
     try:
         result: object = [speak(*request) for request in requests]

@@ -22,6 +22,7 @@ from facelib.checks import check_number
 from facelib.errors import ParameterError, SpeechError
 from facelib.speech.espeak import (
     EspeakEvent,
+    Worker,
     default_words_per_minute,
     list_voices,
     synth_fresh,
@@ -90,6 +91,7 @@ def synthesize(
     voice: str | None = None,
     rate: float = 1.0,
     pitch: float = 50,
+    worker: Worker | None = None,
 ) -> Synthesis:
     """Speak ``text`` in language ``lang`` with espeak-ng.
 
@@ -101,6 +103,8 @@ def synthesize(
         language's own (``voice_for(lang)``).
     rate: speaking rate, 1.0 = espeak-ng's 175 words per minute; 0.5-2.5.
     pitch: base pitch on espeak-ng's 0-100 scale (50 = the voice's own).
+    worker: an espeak-ng process started ahead (:class:`facelib.speech.espeak.Worker`), or
+        None to start one now; the result is the same.
 
     Raises
     ------
@@ -109,7 +113,8 @@ def synthesize(
     """
     if not isinstance(text, str) or not text.strip():
         raise ParameterError(f"text to speak must be a non-empty string, got {text!r}")
-    return synthesize_many([text], lang=lang, voice=voice, rate=rate, pitch=pitch)[0]
+    return synthesize_many([text], lang=lang, voice=voice, rate=rate, pitch=pitch,
+                           worker=worker)[0]
 
 
 def synthesize_many(
@@ -120,10 +125,12 @@ def synthesize_many(
     rate: float = 1.0,
     pitch: float = 50,
     voices: Sequence[str] | None = None,
+    worker: Worker | None = None,
 ) -> list[Synthesis]:
     """:func:`synthesize` of each of ``texts`` (same options), in one fresh espeak-ng
     process (:func:`facelib.speech.espeak.synth_fresh`): the result depends only on the
-    arguments, bit for bit. ``voices`` gives each text its own voice (overrides ``voice``)."""
+    arguments, bit for bit. ``voices`` gives each text its own voice (overrides ``voice``);
+    ``worker``: the process to use, started ahead (see :func:`synthesize`)."""
     for text in texts:
         if not isinstance(text, str) or not text.strip():
             raise ParameterError(f"text to speak must be a non-empty string, got {text!r}")
@@ -134,7 +141,8 @@ def synthesize_many(
         raise ParameterError(f"{len(chosen)} voices for {len(texts)} texts")
     wpm = round(min(max(rate * default_words_per_minute(), _MIN_WPM), _MAX_WPM))
     spoken = [spell_numbers(text, lang=lang) for text in texts]
-    raws = synth_fresh([(s, v, wpm, round(pitch)) for s, v in zip(spoken, chosen, strict=True)])
+    raws = synth_fresh([(s, v, wpm, round(pitch)) for s, v in zip(spoken, chosen, strict=True)],
+                       worker=worker)
     out = []
     for text, said, raw, who in zip(texts, spoken, raws, chosen, strict=True):
         if raw.samples.size == 0 or not any(e.kind == "phone" and e.name for e in raw.events):

@@ -1,6 +1,7 @@
 """The speech rules as data: loaders for the files in ``facelib/data/speech/``.
 
 - ``alignment.json``: forced-alignment settings (frame rate, beams, boundary shifts, checks).
+- ``recognition.json``: speech without a transcript (word decoding, pieces, languages).
 - ``phone_durations.csv``: the text-only duration model.
 - ``pauses.csv``: pauses at punctuation for the duration model.
 - ``duration_rules.json``: the duration model's rules (vowels, lengthening, floors).
@@ -27,6 +28,7 @@ __all__ = [
     "letter_to_sound_rules",
     "pauses",
     "phone_durations",
+    "recognition_settings",
 ]
 
 
@@ -38,6 +40,17 @@ def _alignment() -> Mapping[str, Any]:
 def alignment_settings() -> Mapping[str, Any]:
     """The settings of ``alignment.json`` (keys without ``_about``)."""
     return _alignment()
+
+
+@cache
+def _recognition() -> Mapping[str, Any]:
+    return MappingProxyType(data.json_data("speech/recognition.json"))
+
+
+def recognition_settings() -> Mapping[str, Any]:
+    """The settings of ``recognition.json`` (keys without ``_about``): speech without a
+    transcript."""
+    return _recognition()
 
 
 @cache

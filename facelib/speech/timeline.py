@@ -16,7 +16,8 @@ __all__ = ["SILENCE", "Alphabet", "PhoneTimeline", "Source", "Span", "check_inte
 SILENCE = "SIL"
 """The phone label of silence (and of the acoustic model's noise phones after cleaning)."""
 
-Source = Literal["forced", "phone-loop", "durations", "script", "synthesis", "dtw"]
+Source = Literal["forced", "recognized", "phone-loop", "durations", "script", "synthesis",
+                 "dtw"]
 Alphabet = Literal["arpabet", "ipa"]
 """How phone labels are written: ARPAbet (pocketsphinx, the duration model) or IPA
 (espeak-ng synthesis and the alignment built on it)."""
@@ -25,14 +26,20 @@ Alphabet = Literal["arpabet", "ipa"]
 @dataclass(frozen=True, slots=True)
 class Span:
     """A labelled interval ``[start_ms, end_ms)``: a phone (ARPAbet without stress or IPA,
-    silence as ``"SIL"``) or a word (lower case, silence as ``"SIL"``)."""
+    silence as ``"SIL"``) or a word (lower case, silence as ``"SIL"``). ``confidence``: how
+    sure recognition is of a word it heard (its posterior probability, 0-1); None where the
+    label was given (a transcript) or not judged."""
 
     label: str
     start_ms: int
     end_ms: int
+    confidence: float | None = None
 
     def __post_init__(self) -> None:
         check_interval(self.label, self.start_ms, self.end_ms)
+        if self.confidence is not None and not 0.0 <= self.confidence <= 1.0:
+            raise ParameterError(f"span {self.label!r} confidence must be in [0, 1], "
+                                 f"got {self.confidence!r}")
 
     @property
     def duration_ms(self) -> int:
@@ -47,7 +54,8 @@ class PhoneTimeline:
     """What is said when: ``phones`` and ``words`` (spans in time order), how it was found
     (``source``: ``"forced"`` alignment, ``"phone-loop"`` recognition, ``"durations"`` of the
     text-only model, ``"synthesis"`` by espeak-ng, ``"dtw"`` alignment to a synthesized
-    transcript), ``duration_ms``, the length of the speech, and ``alphabet``, how the phone
+    transcript, ``"recognized"``: words recognised in audio without a transcript, then
+    aligned), ``duration_ms``, the length of the speech, and ``alphabet``, how the phone
     labels are written (``"arpabet"`` or ``"ipa"``)."""
 
     phones: tuple[Span, ...]
@@ -67,9 +75,11 @@ def check_interval(label: str, start_ms: int, end_ms: int) -> None:
         raise ParameterError(f"span {label!r} ends ({end_ms} ms) before it starts ({start_ms} ms)")
 
 
-def append_span(spans: list[Span], label: str, start: int, end: int) -> None:
+def append_span(spans: list[Span], label: str, start: int, end: int, *,
+                confidence: float | None = None) -> None:
     """Append ``[start, end)`` to ``spans`` (in place), clipped to begin where they end:
-    empty spans are dropped, consecutive silences joined and gaps filled with silence."""
+    empty spans are dropped, consecutive silences joined and gaps filled with silence.
+    ``confidence`` goes with the span appended (not with a silence)."""
     if spans:
         start = max(start, spans[-1].end_ms)
     if end <= start:
@@ -78,9 +88,9 @@ def append_span(spans: list[Span], label: str, start: int, end: int) -> None:
         spans[-1] = Span(SILENCE, spans[-1].start_ms, end)
     elif spans and spans[-1].end_ms < start:
         append_span(spans, SILENCE, spans[-1].end_ms, start)
-        append_span(spans, label, start, end)
+        append_span(spans, label, start, end, confidence=confidence)
     else:
-        spans.append(Span(label, start, end))
+        spans.append(Span(label, start, end, None if label == SILENCE else confidence))
 
 
 def cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
@@ -90,7 +100,7 @@ def cover(spans: list[Span], duration_ms: int) -> tuple[Span, ...]:
     if spans and spans[0].start_ms > 0:
         out.append(Span(SILENCE, 0, spans[0].start_ms))
     for span in spans:
-        append_span(out, span.label, span.start_ms, span.end_ms)
+        append_span(out, span.label, span.start_ms, span.end_ms, confidence=span.confidence)
     if out and out[-1].end_ms < duration_ms:
         append_span(out, SILENCE, out[-1].end_ms, duration_ms)
     return tuple(out)

@@ -7,10 +7,12 @@ Each step is a small pure function over :class:`FapTrack` objects:
 3. idle micro-movements of brows, lids and mouth corners (:mod:`facelib.sync.alive`);
 4. :func:`close_lids` for blinks, which no expression may hold open;
 5. :func:`add_head_noise` where gaze does not move the head;
-6. nods on the stressed syllables (:mod:`facelib.sync.nods`), likewise;
+6. nods and the mood's brow beats on the stressed syllables (:mod:`facelib.sync.nods`);
 7. breathing and a listener's head motion, then the eyes' counter-rotation to all of the
    idle head motion (steps 5-7), so gaze stays on its target;
 8. :func:`to_stream`.
+
+A mood (``head_scale``, ``speech_brow``) scales the head motion of 5 and 6 frame by frame.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from facelib.sync.alive import (
     counter_roll_eyes,
     eased,
 )
-from facelib.sync.nods import accents, add_nods
+from facelib.sync.nods import accents, add_brow_beats, add_nods
 from facelib.sync.noise import perlin1d
 from facelib.sync.rules import HeadNoise, SyncRules
 
@@ -86,13 +88,15 @@ def add_head_noise(
     seed: int,
     head_driven: np.ndarray,
     speaking: np.ndarray | None = None,
+    scale: np.ndarray | None = None,
 ) -> FapTrack:
     """Add Perlin head motion to FAP 48-50, faded out where ``head_driven`` (``(n_frames,)``
     in [0, 1], how strongly gaze moves the head) is 1, so gaze-driven head turns are kept.
 
     While ``speaking`` (``(n_frames,) bool``) the motion is livelier: amplitude and
     frequency grow by ``noise.speaking_amplitude`` / ``speaking_frequency``, eased over
-    about half a second so there is no jolt.
+    about half a second so there is no jolt. ``scale`` (``(n_frames,)``, the mood's head
+    motion; None: 1) multiplies the amplitude.
     """
     n = track.n_frames
     t = np.arange(n) / track.fps
@@ -106,6 +110,8 @@ def add_head_noise(
     phase = np.concatenate([[0.0], np.cumsum(rate[:-1])]) / track.fps if n else t
     gain = 1.0 + (noise.speaking_amplitude - 1.0) * talk
     free = 1.0 - np.clip(np.asarray(head_driven, np.float64), 0.0, 1.0)
+    if scale is not None:
+        free = free * np.asarray(scale, np.float64)
     values = track.values.astype(np.float64)
     weight = track.weight.copy()
     for axis, column in enumerate(HEAD_FAPS):
@@ -135,6 +141,8 @@ def combine(
     rules: SyncRules | None = None,
     seed: int = 0,
     liveliness: Liveliness | None = None,
+    head_scale: np.ndarray | None = None,
+    speech_brow: np.ndarray | None = None,
 ) -> FapStream:
     """Resolve the three generators' tracks (all of one length and fps) into a stream.
 
@@ -145,6 +153,8 @@ def combine(
     speaking: ``(n_frames,) bool`` where the character talks (livelier head noise, no
         listening motion).
     liveliness: amplitude and rate factors of the idle motion (default: all 1).
+    head_scale, speech_brow: ``(n_frames,)`` the mood's head-motion factor and brow beat
+        (ENS units; :class:`facelib.expressions.MoodCurves` ``scales``), or None.
     """
     seed = check_seed(seed)
     rules = rules or SyncRules.load()
@@ -164,10 +174,14 @@ def combine(
     head_before = face.values[:, list(HEAD_FAPS)].astype(np.float64)
     if rules.head_noise is not None:
         face = add_head_noise(face, noise=rules.head_noise, seed=seed,
-                              head_driven=head_driven, speaking=speaking)
+                              head_driven=head_driven, speaking=speaking, scale=head_scale)
     if rules.speech_nods is not None:
-        face = add_nods(face, strength=accents(visemes, nods=rules.speech_nods),
-                        nods=rules.speech_nods, seed=seed, head_driven=head_driven)
+        beats = accents(visemes, nods=rules.speech_nods)
+        face = add_nods(face, strength=beats, nods=rules.speech_nods, seed=seed,
+                        head_driven=head_driven, scale=head_scale)
+        if speech_brow is not None:
+            face = add_brow_beats(face, strength=beats, nods=rules.speech_nods,
+                                  brow=speech_brow)
     if alive is not None:
         face = add_alive_head(face, rules=alive, seed=seed, talk=talk, liveliness=lively)
         face = counter_roll_eyes(face, head_before=head_before, gain=alive.vor_gain)

@@ -16,10 +16,11 @@ import numpy as np
 from facelib.mpeg4.tables import ANGLE_UNIT, fap
 from facelib.mpeg4.track import FapTrack
 
-__all__ = ["Nods", "accents", "add_nods"]
+__all__ = ["Nods", "accents", "add_brow_beats", "add_nods"]
 
 _JAW = fap("open_jaw").index
 _PITCH, _YAW, _ROLL = (fap(n).index for n in ("head_pitch", "head_yaw", "head_roll"))
+_BROWS = [fap(f"raise_{s}_{p}_eyebrow").index for s in "lr" for p in "imo"]
 
 
 @dataclass(frozen=True)
@@ -57,15 +58,43 @@ def accents(visemes: FapTrack, *, nods: Nods) -> np.ndarray:
     return out
 
 
+def _pulse(nods: Nods, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Frame offsets and the raised-cosine pulse of one accent over them."""
+    half = nods.duration_ms * fps / 2000.0
+    offsets = np.arange(-int(np.ceil(half)), int(np.ceil(half)) + 1)
+    return offsets, 0.5 * (1.0 + np.cos(np.pi * np.clip(offsets / half, -1.0, 1.0)))
+
+
+def add_brow_beats(track: FapTrack, *, strength: np.ndarray, nods: Nods,
+                   brow: np.ndarray) -> FapTrack:
+    """Raise (or, negative, lower) the brows on each accent (``strength``, from
+    :func:`accents`) by ``brow`` (``(n_frames,)`` ENS units at a full accent, the mood's
+    ``speech_brow``), with the nods' pulse; unchanged where ``brow`` is 0."""
+    brow = np.asarray(brow, np.float64)
+    if not brow.any() or not strength.any():
+        return track
+    n = track.n_frames
+    offsets, pulse = _pulse(nods, track.fps)
+    wave = np.zeros(n)
+    for i in np.flatnonzero(strength):
+        at = i + offsets
+        keep = (at >= 0) & (at < n)
+        wave[at[keep]] += strength[i] * brow[i] * pulse[keep]
+    values = track.values.astype(np.float64)
+    weight = track.weight.copy()
+    values[:, _BROWS] += wave[:, None]
+    weight[:, _BROWS] = np.maximum(weight[:, _BROWS], (wave != 0)[:, None].astype(np.float32))
+    return FapTrack(track.fps, values.astype(np.float32), weight)
+
+
 def add_nods(track: FapTrack, *, strength: np.ndarray, nods: Nods, seed: int,
-             head_driven: np.ndarray) -> FapTrack:
+             head_driven: np.ndarray, scale: np.ndarray | None = None) -> FapTrack:
     """Add a nod per accent (``strength``, from :func:`accents`) to FAP 48-50, faded out
-    where gaze moves the head (``head_driven`` in [0, 1])."""
+    where gaze moves the head (``head_driven`` in [0, 1]) and scaled by ``scale``
+    (``(n_frames,)``, the mood's head motion; None: 1)."""
     n = track.n_frames
     rng = np.random.default_rng([seed, 14])
-    half = nods.duration_ms * track.fps / 2000.0
-    offsets = np.arange(-int(np.ceil(half)), int(np.ceil(half)) + 1)
-    pulse = 0.5 * (1.0 + np.cos(np.pi * np.clip(offsets / half, -1.0, 1.0)))
+    offsets, pulse = _pulse(nods, track.fps)
     wave = np.zeros((n, 3))
     for i in np.flatnonzero(strength):
         size = strength[i] * (1.0 + nods.jitter * rng.uniform(-1.0, 1.0))
@@ -75,6 +104,8 @@ def add_nods(track: FapTrack, *, strength: np.ndarray, nods: Nods, seed: int,
         keep = (at >= 0) & (at < n)
         wave[at[keep]] += size * pulse[keep, None] * angles[None, :]
     free = 1.0 - np.clip(np.asarray(head_driven, np.float64), 0.0, 1.0)
+    if scale is not None:
+        free = free * np.asarray(scale, np.float64)
     values = track.values.astype(np.float64)
     weight = track.weight.copy()
     for axis, column in enumerate((_PITCH, _YAW, _ROLL)):

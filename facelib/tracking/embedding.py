@@ -19,7 +19,7 @@ import numpy as np
 from facelib.checks import check_number
 from facelib.data import json_data
 from facelib.data import path as data_path
-from facelib.engine.face import OPTIONAL_PARTS
+from facelib.engine.face import ATTACHED_PARTS, OPTIONAL_PARTS
 from facelib.errors import DataError, TrackingError
 from facelib.mpeg4 import N_FAPS, FapStream
 from facelib.rendering.protocols import Deformable
@@ -43,14 +43,15 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
         nearest the camera is taken (else the nearest projection).
     """
     from facelib.rendering import FaceRenderer
+    from facelib.rendering.scene import framing_points
     from facelib.tracking.mediapipe import FaceMeshTracker
 
     radius = check_number("radius", radius, low=0, low_open=True)
     values = np.zeros(N_FAPS, np.float32)
     values[2] = check_number("open_jaw", open_jaw, low=0)
     vertices = np.asarray(face.deform(FapStream(25.0, values[None]))[0], np.float64)
-    with FaceRenderer(_without_hair(face), width=width, height=height,
-                      framing="head") as renderer:
+    with FaceRenderer(_without_hair(face), width=width, height=height,  # framed with them
+                      framing=framing_points(face, "head")) as renderer:
         image = renderer.frame(vertices)
         projected = renderer.project(vertices)
         camera = np.linalg.inv(renderer.camera_pose)
@@ -60,7 +61,7 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
         raise TrackingError("MediaPipe finds no face on the rendered neutral mesh")
     depth = -(np.hstack([vertices, np.ones((len(vertices), 1))]) @ camera.T)[:, 2]
     parts = getattr(face, "parts", {}) or {}
-    hair = [parts[p].vertex_ids for p in OPTIONAL_PARTS if p in parts]
+    hair = [parts[p].vertex_ids for p in (*OPTIONAL_PARTS, *ATTACHED_PARTS) if p in parts]
     projected[np.concatenate([np.zeros(0, np.int64), *hair])] = np.inf  # no landmark there
     out = np.empty(N_LANDMARKS, np.int64)
     for i, point in enumerate(found.points[:, :2]):
@@ -71,10 +72,10 @@ def embed_landmarks(face: Deformable, *, open_jaw: float = 400.0, width: int = 6
 
 
 def _without_hair(face: Deformable) -> Deformable:
-    """``face`` as the renderer sees it, less its optional parts (the lashes): landmarks
-    lie on the skin, and MediaPipe should see it unhidden."""
+    """``face`` as the renderer sees it, less its optional and attached parts (lashes, hair,
+    bust): landmarks lie on the skin, and MediaPipe should see it unhidden."""
     parts = dict(getattr(face, "parts", {}) or {})
-    hair = [parts.pop(p) for p in OPTIONAL_PARTS if p in parts]
+    hair = [parts.pop(p) for p in (*OPTIONAL_PARTS, *ATTACHED_PARTS) if p in parts]
     if not hair:
         return face
     drop = np.concatenate([h.vertex_ids for h in hair])

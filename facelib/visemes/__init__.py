@@ -17,6 +17,7 @@ from facelib.visemes.animate import (
     timeline_from_text,
 )
 from facelib.visemes.coarticulation import blend, driven_faps, envelope
+from facelib.visemes.from_audio import visemes_from_audio
 from facelib.visemes.mapping import phones_to_visemes, visemes_for, with_visemes
 from facelib.visemes.scripts import (
     timeline_from_json,
@@ -65,6 +66,7 @@ __all__ = [
     "viseme_name",
     "viseme_targets",
     "visemes_for",
+    "visemes_from_audio",
     "visemes_from_cues",
     "with_visemes",
     "write_timeline",

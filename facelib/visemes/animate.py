@@ -18,7 +18,9 @@ from facelib.speech import timeline_from_text as phones_from_text
 from facelib.speech.align import OnImplausible
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.dtw import align_dtw as align_phones_dtw
+from facelib.speech.espeak import Worker
 from facelib.speech.loudness import FLOOR_DB, window_loudness
+from facelib.speech.recognize import recognize
 from facelib.speech.synth import DEFAULT_LANGUAGE
 from facelib.speech.synth import synthesize as synthesize_speech
 from facelib.speech.timeline import PhoneTimeline
@@ -108,13 +110,14 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0,
     """The timeline of ``speech`` in its own time (ms from ``speech.start_ms``): a stored
     viseme script as it is; audio and text by forced alignment (English: pocketsphinx,
     falling back to DTW; other languages: DTW against espeak-ng); audio alone by
-    phone-loop recognition (English); text alone synthesized by espeak-ng. ``rate``
+    recognition (English words, then the phone loop; see
+    :func:`facelib.speech.recognize.recognize`); text alone synthesized by espeak-ng. ``rate``
     multiplies ``speech.rate``; ``language`` is the storyboard's (``speech.lang`` wins)."""
     return _spoken(speech, rate=rate, language=language)[0]
 
 
 def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
-            ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+            worker: Worker | None = None) -> tuple[SpeechTimeline, SpeechAudio | None]:
     lang = speech.lang or language or DEFAULT_LANGUAGE
     if speech.visemes:
         spans = visemes_from_cues(speech.visemes)
@@ -136,7 +139,8 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
                               f"{MAX_SPEECH_TEXT_CHARS}", path=path, line=line)
         try:
             made = synthesize_speech(speech.text, lang=lang, voice=speech.voice,
-                              rate=min(max(speech.rate * rate, 0.5), 2.5), pitch=speech.pitch)
+                                     rate=min(max(speech.rate * rate, 0.5), 2.5),
+                                     pitch=speech.pitch, worker=worker)
         except MissingExtraError:
             if not lang.lower().startswith("en"):
                 raise
@@ -150,18 +154,17 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
 
 
 def _recorded(audio: Path, text: str | None, lang: str, voice: str | None) -> PhoneTimeline:
-    """Phones of recorded ``audio``: pocketsphinx for English (DTW if it fails), DTW
-    against the synthesized transcript for any other language."""
+    """Phones of recorded ``audio``: with a transcript, pocketsphinx for English (DTW if it
+    fails) and DTW against the synthesized transcript for any other language; without one,
+    recognition (:func:`facelib.speech.recognize.recognize`: English words, then the phone
+    loop; a clear SpeechError for a language without a model)."""
+    if text is None:
+        return recognize(audio, language=lang)
     if lang.lower().startswith("en"):
         try:
             return align_phones(audio, text)
         except SpeechError:
-            if text is None:
-                raise
             return align_phones_dtw(audio, text, lang=lang, voice=voice)
-    if text is None:
-        raise SpeechError(f"speech audio in {lang!r} needs its transcript (recognition without "
-                          "one is English only)", path=audio)
     return align_phones_dtw(audio, text, lang=lang, voice=voice)
 
 
@@ -187,14 +190,15 @@ def animate(speech: SpeechSpec, *, fps: float, rate: float = 1.0,
 
 
 def spoken(speech: SpeechSpec, *, rate: float = 1.0, language: str | None = None,
-           ) -> tuple[SpeechTimeline, SpeechAudio | None]:
+           worker: Worker | None = None) -> tuple[SpeechTimeline, SpeechAudio | None]:
     """The timeline of ``speech`` in its own time (as :func:`speech_timeline`) and its
     synthesized audio (None for a recording or a viseme script): the slow half of
     :func:`animate`, which a live session runs once per sentence before it knows when the
-    sentence will start."""
+    sentence will start. ``worker``: an espeak-ng process started ahead for text (the same
+    result, sooner; :class:`facelib.speech.espeak.Worker`)."""
     speech = check_kind("speech", speech, SpeechSpec)
     rate = check_number("rate", rate, low=0.25, high=4.0)
-    return _spoken(speech, rate=rate, language=language)
+    return _spoken(speech, rate=rate, language=language, worker=worker)
 
 
 def animate_spoken(speech: SpeechSpec, own: SpeechTimeline, audio: SpeechAudio | None, *,

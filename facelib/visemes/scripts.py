@@ -5,12 +5,14 @@ JSON (also what ``facelib align`` writes)::
     {"source": "forced", "duration": 3.54,
      "phones": [{"phone": "HH", "start": 0.255, "end": 0.39}, ...],
      "words": [{"word": "hello", "start": 0.255, "end": 0.6}, ...],
+     (a word recognised in audio without a transcript adds "confidence": 0-1)
      "visemes": [{"viseme": 10, "name": "aa", "start": 0.3, "end": 0.41,
                   "phones": ["AH"]}, ...]}
 
 Times in seconds, phones in ARPAbet without stress, silence as ``SIL``. TSV has one row per
-span: ``tier  label  start  end  viseme``. The ``Sentence`` script is Lua, one
-``{"name", frames}`` entry per viseme, durations in frames of the storyboard's fps.
+span: ``tier  label  start  end  viseme  confidence`` (confidence: recognised words only).
+The ``Sentence`` script is Lua, one ``{"name", frames}`` entry per viseme, durations in
+frames of the storyboard's fps.
 """
 
 from __future__ import annotations
@@ -49,11 +51,18 @@ def timeline_to_json(timeline: SpeechTimeline) -> dict[str, Any]:
         "duration": _s(timeline.duration_ms),
         "phones": [{"phone": p.label, "start": _s(p.start_ms), "end": _s(p.end_ms)}
                    for p in timeline.phones],
-        "words": [{"word": w.label, "start": _s(w.start_ms), "end": _s(w.end_ms)}
-                  for w in timeline.words],
+        "words": [_word_json(w) for w in timeline.words],
         "visemes": [{"viseme": v.viseme, "name": v.name, "start": _s(v.start_ms),
                      "end": _s(v.end_ms), "phones": list(v.phones)} for v in timeline.visemes],
     }
+
+
+def _word_json(word: Span) -> dict[str, Any]:
+    out: dict[str, Any] = {"word": word.label, "start": _s(word.start_ms),
+                           "end": _s(word.end_ms)}
+    if word.confidence is not None:
+        out["confidence"] = round(word.confidence, 3)
+    return out
 
 
 def timeline_from_json(data: Mapping[str, Any]) -> SpeechTimeline:
@@ -63,7 +72,9 @@ def timeline_from_json(data: Mapping[str, Any]) -> SpeechTimeline:
             return round(float(x) * 1000)
 
         phones = tuple(Span(p["phone"], ms(p["start"]), ms(p["end"])) for p in data["phones"])
-        words = tuple(Span(w["word"], ms(w["start"]), ms(w["end"])) for w in data["words"])
+        words = tuple(Span(w["word"], ms(w["start"]), ms(w["end"]),
+                           None if w.get("confidence") is None else float(w["confidence"]))
+                      for w in data["words"])
         visemes = tuple(
             VisemeSpan(int(v["viseme"]), viseme_name(int(v["viseme"])), ms(v["start"]),
                        ms(v["end"]), tuple(v.get("phones", ())))
@@ -81,12 +92,13 @@ def timeline_from_json(data: Mapping[str, Any]) -> SpeechTimeline:
 
 
 def timeline_to_tsv(timeline: SpeechTimeline) -> str:
-    """Tab-separated ``tier label start end viseme`` rows (times in s; viseme id on the
-    viseme tier only), with a header line."""
-    rows = ["tier\tlabel\tstart\tend\tviseme"]
-    rows += [f"phone\t{p.label}\t{_s(p.start_ms)}\t{_s(p.end_ms)}\t" for p in timeline.phones]
-    rows += [f"word\t{w.label}\t{_s(w.start_ms)}\t{_s(w.end_ms)}\t" for w in timeline.words]
-    rows += [f"viseme\t{v.name}\t{_s(v.start_ms)}\t{_s(v.end_ms)}\t{v.viseme}"
+    """Tab-separated ``tier label start end viseme confidence`` rows (times in s; viseme id
+    on the viseme tier only; confidence on recognised words only), with a header line."""
+    rows = ["tier\tlabel\tstart\tend\tviseme\tconfidence"]
+    rows += [f"phone\t{p.label}\t{_s(p.start_ms)}\t{_s(p.end_ms)}\t\t" for p in timeline.phones]
+    rows += [f"word\t{w.label}\t{_s(w.start_ms)}\t{_s(w.end_ms)}\t\t"
+             f"{'' if w.confidence is None else round(w.confidence, 3)}" for w in timeline.words]
+    rows += [f"viseme\t{v.name}\t{_s(v.start_ms)}\t{_s(v.end_ms)}\t{v.viseme}\t"
              for v in timeline.visemes]
     return "\n".join(rows) + "\n"
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import shutil
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
@@ -11,6 +10,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from head_files import copy_head_files
 
 from facelib.engine import load_face, required_feature_points
 from facelib.errors import FaceModelError
@@ -19,8 +19,7 @@ HEAD = Path(str(resources.files("facelib.data").joinpath("head")))
 
 
 def broken(tmp_path: Path, edit: Callable[[dict[str, Any]], None]) -> Path:
-    shutil.copy(HEAD / "default_head.npz", tmp_path / "default_head.npz")
-    doc = json.loads((HEAD / "default_head.json").read_text())
+    doc = copy_head_files(tmp_path)
     edit(doc)
     out = tmp_path / "face.json"
     out.write_text(json.dumps(doc))

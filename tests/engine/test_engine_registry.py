@@ -82,13 +82,10 @@ def test_custom_deformer_object(face: Face) -> None:
 
 def test_definition_params_and_group_keys(tmp_path) -> None:  # type: ignore[no-untyped-def]
     import json
-    import shutil
-    from importlib import resources
-    from pathlib import Path
 
-    head = Path(str(resources.files("facelib.data").joinpath("head")))
-    shutil.copy(head / "default_head.npz", tmp_path / "default_head.npz")
-    doc = json.loads((head / "default_head.json").read_text())
+    from head_files import copy_head_files
+
+    doc = copy_head_files(tmp_path)
     lip = next(r for r in doc["regions"] if r["name"] == "upper_lip")
     lip["deformer"] = "soffd"
     lip["params"] = {"local": 3.0}

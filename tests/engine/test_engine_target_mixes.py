@@ -30,10 +30,13 @@ def _mix(name: str) -> np.ndarray:
         return data[f"mix_{name}"]
 
 
-@pytest.mark.parametrize("name", ["joy", "surprise", "fear"])
+@pytest.mark.parametrize("name", ["joy", "surprise"])
 def test_expression_moves_like_its_target_mix(face, name):
     """At the mouth corners, cheeks and chin the library expression moves the skin within
-    30 % of the textbook ARKit mix (where the mix moves a point by over a millimetre)."""
+    30 % of the textbook ARKit mix (where the mix moves a point by over a millimetre).
+    Fear left this test in issue 32: rebuilt on its action units it parts the lips (AU25)
+    and drops the jaw (AU26) more than the mix's jawOpen 0.2; tests/expressions/
+    test_action_units.py checks its regions instead."""
     mix = _mix(name)
     moved = face.deform_frame(default_library().get(name).values) - face.vertices
     checked = 0

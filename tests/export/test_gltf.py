@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 from facelib.data import json_data
 from facelib.engine import default_face
 from facelib.export import export_gltf
+from facelib.export.gltf import primitive_vertex_ids
 from facelib.mpeg4 import fap
 
 WEB = Path(__file__).parents[2] / "facelib" / "export" / "web"
@@ -34,12 +35,35 @@ def test_evaluated_gltf_matches_deform_within_a_tenth_of_a_millimetre(exported):
     for frame in (0, 3, 6, 9, 11):
         got = gltf.evaluate(frame)
         for part, positions in zip(face.parts.values(), got, strict=True):
-            ids = np.sort(part.vertex_ids)
+            ids = primitive_vertex_ids(part)
             worst = max(worst, float(np.abs(positions - want[frame][ids]).max()))
     assert worst < 1e-4, f"{worst * 1000:.4f} mm"
     print(f"worst {worst * 1000:.5f} mm")
     # the deformation is real: frame 6 moves the face by centimetres
     assert np.abs(want[6] - face.vertices).max() > 0.01
+
+
+def test_each_primitive_indexes_its_own_vertices_the_bust_copies_the_neck_loop(exported):
+    """A primitive's indices name only its own vertices: the bust's triangles that join it to
+    the head's neck loop get copies of those skin vertices (same place, same normal), so
+    the seam stays closed and shaded alike."""
+    result, _ = exported
+    face = default_face()
+    gltf = Gltf(result.path)
+    prims = dict(zip(face.parts, gltf.g.meshes[0].primitives, strict=True))
+    for name, prim in prims.items():
+        positions = gltf.accessor(prim.attributes.POSITION)
+        tris = gltf.accessor(prim.indices).reshape(-1, 3)
+        ids = primitive_vertex_ids(face.parts[name])
+        assert tris.max() < len(positions) == len(ids), name
+        assert len(tris) == len(face.parts[name].triangles), name
+        np.testing.assert_allclose(positions, face.vertices[ids], atol=1e-6)
+    bust = face.parts["bust"]
+    borrowed = primitive_vertex_ids(bust)[bust.vertex_ids.size:]
+    assert len(borrowed) > 20 and np.isin(borrowed, face.parts["skin"].vertex_ids).all()
+    normals = [gltf.accessor(prims[n].attributes.NORMAL) for n in ("skin", "bust")]
+    at_skin = np.searchsorted(np.sort(face.parts["skin"].vertex_ids), borrowed)
+    np.testing.assert_allclose(normals[1][bust.vertex_ids.size:], normals[0][at_skin])
 
 
 def test_vertex_colours_carry_the_baked_occlusion(exported):
@@ -149,7 +173,7 @@ def test_no_negative_morph_weights_a_signed_fap_is_two_targets(tmp_path):
     for frame in (0, 4, 8):
         got = gltf.evaluate(frame)
         for part, positions in zip(face.parts.values(), got, strict=True):
-            ids = np.sort(part.vertex_ids)
+            ids = primitive_vertex_ids(part)
             np.testing.assert_allclose(positions, want[frame][ids], atol=1e-4)
 
 

@@ -72,9 +72,12 @@ def test_curve_ramps_holds_returns_to_neutral_and_scales_with_intensity():
     cue = ExpressionCue("joy", start_ms=400, duration_ms=2000, intensity=0.5)
     track = animate([cue], fps=25, n_frames=100)
     corner = track.values[:, fap("raise_l_cornerlip").index]
-    full = default_library().get("joy").values[fap("raise_l_cornerlip").index]
+    joy = default_library().get("joy")
+    full = joy.values[fap("raise_l_cornerlip").index]
     assert corner[:11].max() == 0  # before the cue (frame 10 = 400 ms)
-    assert corner[40] == pytest.approx(0.5 * full)  # holding
+    # holding, at the share its intensity curve gives 0.5 (more than half)
+    assert corner[40] == pytest.approx(0.5**joy.exponent * full)
+    assert 0.5 < joy.share(0.5) < 1
     assert corner[70:].max() == 0  # after it: neutral
     assert 0 < corner[13] < corner[40]  # ramping in
     assert track.weight[40, fap("raise_l_cornerlip").index] == 1
@@ -115,7 +118,8 @@ def test_default_ramps_come_from_the_data_file():
 
 def _dense_animate(cues, *, fps, n_frames, importance, easing):  # type: ignore[no-untyped-def]
     """The expression track as it was computed before issue 30: every cue's envelope over
-    every frame, added into full arrays (quadratic time; the reference for the span form)."""
+    every frame, added into full arrays (quadratic time; the reference for the span form;
+    the intensity curves of issue 32 applied)."""
     from facelib.expressions.curves import _ramps
 
     library = default_library()
@@ -126,7 +130,7 @@ def _dense_animate(cues, *, fps, n_frames, importance, easing):  # type: ignore[
         ramp_in, ramp_out = _ramps(cue)
         e = envelope(times, start_ms=cue.start_ms, duration_ms=cue.duration_ms,
                      ramp_in_ms=ramp_in, ramp_out_ms=ramp_out, easing=easing)[:, None]
-        total += e * cue.intensity * expression.values
+        total += e * expression.share(cue.intensity) * expression.values
         strength += e * expression.mask
         weight += e * expression.mask * float(importance.get(expression.name, 1.0))
     return ((total / np.maximum(strength, 1.0)).astype(np.float32),

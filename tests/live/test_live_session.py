@@ -123,3 +123,19 @@ def test_streamed_audio_moves_the_jaw_in_its_frames() -> None:
     first = np.flatnonzero(np.abs(heard) > 1e-3)[0]
     assert abs(first - 80 * OUTPUT_RATE // 1000) < OUTPUT_RATE // 100  # out after 80 ms
     assert jaw.max() > 0 and any(o.frame.viseme > 0 for o in frames)
+
+
+def test_windows_computed_ahead_on_the_wall_clock_give_the_same_frames() -> None:
+    async def run() -> list:
+        async with Session(fps=30, seed=4) as s:  # wall clock: windows come from a thread
+            out = []
+            async for o in s.frames():
+                out.append(o)
+                if len(out) == 100:  # past the first window's prefetch point
+                    return out
+        return out
+
+    live = asyncio.run(run())
+    alone = Engine(fps=30, seed=4).advance(100 * 1000 / 30)
+    assert [o.frame.index for o in live] == list(range(100))
+    assert all(np.array_equal(o.frame.faps, f.faps) for o, f in zip(live, alone, strict=True))

@@ -19,9 +19,12 @@ W, H = 96, 72
 
 
 def _coverage(frames: np.ndarray) -> np.ndarray:
-    """(n,) share of each frame's pixels that differ from its top-left (background) pixel."""
+    """(n,) share of each frame's pixels that show skin: bright and red over blue (sRGB
+    red > 120 and red - blue > 50), which the dark background, the blue garment and the
+    brown hair are not. The face's size, not that of all that is not background: the bust
+    framing shows more garment, which fills the frame as the face shrinks."""
     f = frames.astype(int)
-    return (np.abs(f - f[:, :1, :1]).sum(axis=3) > 30).mean(axis=(1, 2))
+    return ((f[..., 0] > 120) & (f[..., 0] - f[..., 2] > 50)).mean(axis=(1, 2))
 
 
 def _source(cues: tuple[CameraCue, ...], n_frames: int) -> SimpleNamespace:

@@ -103,8 +103,12 @@ def test_any_rate_and_channels(tmp_path):
 
 
 def test_phone_loop_without_transcript():
-    timeline = align(FIXTURES / "quick_fox.flac")
+    from facelib.speech.recognize import recognize
+    from facelib.visemes import with_visemes
+
+    timeline = with_visemes(recognize(FIXTURES / "quick_fox.flac", method="phones"))
     assert timeline.source == "phone-loop" and timeline.words == ()
+    assert align(FIXTURES / "quick_fox.flac").source == "recognized"  # the default since #34
     speech = [p for p in timeline.phones if p.label != "SIL"]
     assert len(speech) >= 15
     assert timeline.visemes[0].start_ms == 0

@@ -120,3 +120,21 @@ def test_bad_arguments():
         synthesize("hello", rate=9)
     with pytest.raises(ParameterError, match="non-empty"):
         synthesize("   ")
+
+
+def test_a_worker_started_ahead_speaks_as_a_fresh_one():
+    import time
+
+    from facelib.speech.espeak import Worker
+
+    fresh = synthesize("How are you today?")
+    ahead = Worker()
+    time.sleep(0.3)  # loaded and waiting when the text comes
+    made = synthesize("How are you today?", worker=ahead)
+    assert np.array_equal(made.samples, fresh.samples)
+    assert made.timeline == fresh.timeline
+    with pytest.raises(SpeechError):  # one batch per process
+        synthesize("Again.", worker=ahead)
+    unused = Worker()
+    unused.close()
+    unused.close()  # closing twice is harmless

@@ -50,7 +50,12 @@ def test_track_writes_fap_landmarks_and_mirror(face_video, tmp_path, capsys):
     # integer rounding: a few units, 1e-5 rad for angles)
     assert main(["track", str(tmp_path / "l.csv"), "-o", str(tmp_path / "again.fap"),
                  "--neutral", "0:4"]) == 0
-    np.testing.assert_allclose(read_fap(tmp_path / "again.fap").values, stream.values, atol=6)
+    # (the brows, FAPs 31-36, are read off the video's images too: the file lacks them)
+    again = read_fap(tmp_path / "again.fap").values
+    rest = np.ones(84, bool)
+    rest[30:36] = False
+    np.testing.assert_allclose(again[:, rest], stream.values[:, rest], atol=6)
+    assert np.abs(again[:, ~rest] - stream.values[:, ~rest]).max() < 30
     info = probe_video(tmp_path / "mirror.mp4")
     assert info["frames"] == N and info["audio"]
     meta, frames = read_video(tmp_path / "mirror.mp4")

@@ -36,7 +36,7 @@ def test_json_round_trip(timeline, tmp_path):
 
 def test_tsv_rows(timeline):
     rows = timeline_to_tsv(timeline).splitlines()
-    assert rows[0] == "tier\tlabel\tstart\tend\tviseme"
+    assert rows[0] == "tier\tlabel\tstart\tend\tviseme\tconfidence"
     assert len(rows) == 1 + len(timeline.phones) + len(timeline.words) + len(timeline.visemes)
     assert rows[-1].split("\t")[0] == "viseme"
 

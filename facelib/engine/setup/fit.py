@@ -45,7 +45,7 @@ class FaceSetup:
     rotation: (3, 3) float64 rotation applied to the mesh, the given axes' included
         (identity if it was upright).
     carried: parts of the face the mesh lacked (lashes always), warped into place from
-        the source.
+        the source (its attached bust, garment and hair are not: they fit the source head).
     landmarks: feature point ids used as landmarks, in fit order.
     residual: (n,) float64 metres: each landmark's distance to the mesh surface as given.
     tps: the fitted warp (source feature points -> the landmarks).

@@ -14,7 +14,9 @@
 5. parts the target lacks (eyeballs, teeth, tongue) are carried: eyeballs by a similarity
    about ``T(centre)`` so they stay spheres, teeth and tongue through ``T``; the source's
    lashes are always carried through ``T``, each lash vertex riding on the target vertices
-   nearest to its anchors' guide positions.
+   nearest to its anchors' guide positions. The source's attached parts (bust, garment,
+   hair: :mod:`~facelib.engine.attachments`) are not transferred: they are fitted to the
+   source head (the bust shares its neck loop), so the new face has the head's parts only.
 
 FAPU come out of the new mesh when the :class:`~facelib.engine.face.Face` is built, which
 rescales every FAP stream to the new proportions (the seed's animation transfer).

@@ -20,6 +20,7 @@ from visemes_festival import synthesize  # noqa: E402
 FIXTURES = {
     "quick_fox": "The quick brown fox jumps over the lazy dog.",
     "oov_names": "Zorblat met Quixotl near the glimmerfen bridge.",
+    "bilabials": "Bob made a map of the big pump by the moor.",
 }
 
 
