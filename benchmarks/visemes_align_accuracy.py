@@ -37,7 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from visemes_festival import synthesize
 
 from facelib.speech import align_dtw
-from facelib.speech.align import _decoder
+from facelib.speech.decoding import new_decoder
 from facelib.visemes import align
 from facelib.visemes.ipa import ipa_viseme
 from facelib.visemes.tables import phone_viseme
@@ -160,7 +160,7 @@ def main() -> None:
     args = [a for a in sys.argv[1:] if a not in ("-v", "--dtw")]
     n = int(args[0]) if args else len(SENTENCES)
     t0 = time.perf_counter()
-    _decoder()
+    new_decoder()
     print(f"model load {time.perf_counter() - t0:.2f} s (once per process)")
     with tempfile.TemporaryDirectory() as tmp:
         for name, sentences in SETS.items():

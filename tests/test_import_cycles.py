@@ -86,18 +86,10 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str]:
     return []
 
 
-# Lazy (function-level) imports that close a circle and are not split yet, each to be
-# removed when its circle is: speech.align hands a call without a transcript to
-# speech.recognize, which builds on align's decoder helpers (landed with issue 35's live
-# work; splitting align's helpers into their own module ends it).
-KNOWN_LAZY_EDGES = {("facelib.speech.align", "facelib.speech.recognize")}
 
 
 def test_no_import_circle_in_facelib() -> None:
     graph = import_graph()
-    for a, b in KNOWN_LAZY_EDGES:
-        assert b in graph[a], f"{a} no longer imports {b}: drop it from KNOWN_LAZY_EDGES"
-        graph[a] = graph[a] - {b}
     cycle = find_cycle(graph)
     assert not cycle, "import circle: " + " -> ".join(cycle)
 

@@ -13,8 +13,8 @@ from typing import Any
 import numpy as np
 
 from facelib.errors import ParameterError
-from facelib.speech.align import _NOISE, _PHONE_LOOP, _decoder
 from facelib.speech.audio import ALIGN_RATE, to_pcm16
+from facelib.speech.decoding import NOISE, PHONE_LOOP, new_decoder
 from facelib.speech.loudness import window_loudness
 from facelib.speech.tables import alignment_settings
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Span, append_span, cover
@@ -58,8 +58,8 @@ class Listener:
         """Load the recognizer (about 0.6 s and 90 MB) and open the next stretch's utterance
         (its leading pad decoded) now, rather than at the first samples."""
         if self._decoder is None:
-            decoder = _decoder()
-            decoder.activate_search(_PHONE_LOOP)
+            decoder = new_decoder()
+            decoder.activate_search(PHONE_LOOP)
             self._decoder = decoder
         if not self._open:
             self._decoder.start_utt()
@@ -88,7 +88,7 @@ class Listener:
         duration = self.duration_ms
         spans: list[Span] = []
         for seg in self._decoder.seg():
-            label = SILENCE if seg.word in _NOISE else seg.word
+            label = SILENCE if seg.word in NOISE else seg.word
             start = min(max(seg.start_frame * frame - pad, 0), duration)
             end = min(max((seg.end_frame + 1) * frame - pad, 0), duration)
             append_span(spans, label, int(start), int(end))

@@ -22,8 +22,8 @@ import numpy as np
 
 from facelib.errors import ParameterError, SpeechError
 from facelib.optional import require
-from facelib.speech.align import _decode, _forced, _phone_loop, tokenize_words
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
+from facelib.speech.decoding import decode, forced, phone_loop, tokenize_words
 from facelib.speech.tables import alignment_settings, recognition_settings
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Source, Span, append_span, cover
 
@@ -114,7 +114,7 @@ def _recognize_piece(
         elif method == "words":
             raise SpeechError("no word recognised in the audio")
     try:
-        return _phone_loop(to_pcm16(samples, pad_ms=pad), duration_ms), (), "phone-loop"
+        return phone_loop(to_pcm16(samples, pad_ms=pad), duration_ms), (), "phone-loop"
     except SpeechError:
         silence = (Span(SILENCE, 0, duration_ms),) if duration_ms > 0 else ()
         return silence, (), "phone-loop"
@@ -126,7 +126,7 @@ def _align_decoded(
     """Pass 2: the decoded words force-aligned, each word span with its confidence."""
     pad = alignment_settings()["pad_ms"]
     text = " ".join(t for t, _ in tokens)
-    phones, words, _, _ = _forced(to_pcm16(samples, pad_ms=pad), text, duration_ms, None, {})
+    phones, words, _, _ = forced(to_pcm16(samples, pad_ms=pad), text, duration_ms, None, {})
     spoken = iter(c for _, c in tokens)
     out = []
     for w in words:
@@ -144,7 +144,7 @@ def decode_words(samples: np.ndarray) -> list[tuple[str, float]]:
     the word alone. Empty when no word is heard."""
     settings = recognition_settings()
     decoder = _word_decoder(settings)
-    _decode(decoder, to_pcm16(samples, pad_ms=alignment_settings()["pad_ms"]))
+    decode(decoder, to_pcm16(samples, pad_ms=alignment_settings()["pad_ms"]))
     out = []
     for seg in decoder.seg():
         if seg.word in _FILLERS:
