@@ -37,6 +37,7 @@ __all__ = [
     "Clip",
     "Deformable",
     "Speech",
+    "check_hair",
     "face_for",
     "make_clip",
     "resolve_face",
@@ -169,17 +170,30 @@ def styled_face(definition: str | os.PathLike[str] | None, hair: str | None) -> 
     """The face definition JSON ``definition`` (None: the bundled head) loaded wearing the
     hair style ``hair`` (``"none"``: bald; None: the definition's own). ParameterError
     naming the definition's styles, with a did-you-mean, for a style it does not have."""
-    from facelib.engine import hair_style_names, load_face
+    from facelib.engine import load_face
 
     if hair is None:
         return resolve_face(definition)
     where = None if definition is None else Path(definition)
-    styles = hair_style_names(where)
-    if hair not in styles:
-        name = "the bundled head" if where is None else where.name
-        raise ParameterError(f"hair style {hair!r} is not one of {name}'s ("
-                             f"{', '.join(styles)}){did_you_mean(hair, styles)}")
+    check_hair(where, hair)
     return load_face(where, hair=hair)
+
+
+def check_hair(definition: str | os.PathLike[str] | None, hair: str, *,
+               path: str | Path | None = None, line: int | None = None) -> None:
+    """Check that ``hair`` is a style of the face definition ``definition`` (None: the
+    bundled head) without loading the face: ParameterError naming its styles, with a
+    did-you-mean, or FdlError at ``path``:``line`` when a storyboard file is given."""
+    from facelib.engine import hair_style_names
+
+    where = None if definition is None else Path(definition)
+    styles = hair_style_names(where)
+    if hair in styles:
+        return
+    name = "the bundled head" if where is None else where.name
+    message = (f"hair style {hair!r} is not one of {name}'s ({', '.join(styles)})"
+               f"{did_you_mean(hair, styles)}")
+    raise ParameterError(message) if path is None else FdlError(message, path=path, line=line)
 
 
 def face_for(source: object, definition: str | os.PathLike[str] | None,
@@ -241,12 +255,10 @@ def _storyboard_face(storyboard: object, *, use_face: bool,
     hair = getattr(storyboard, "hair", None) if use_hair else None
     if hair is None:
         return None if named is None else resolve_face(named)
-    try:
-        return styled_face(named, hair)
-    except ParameterError as exc:
-        lines = getattr(storyboard, "setting_lines", None) or {}
-        raise FdlError(exc.message, path=getattr(storyboard, "path", None),
-                       line=lines.get("hair")) from None
+    lines = getattr(storyboard, "setting_lines", None) or {}
+    check_hair(named, hair, path=getattr(storyboard, "path", None) or "<storyboard>",
+               line=lines.get("hair"))
+    return styled_face(named, hair)
 
 
 def _from_source(source: object, *, storyboard_face: bool, storyboard_hair: bool) -> Clip:

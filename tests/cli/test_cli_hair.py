@@ -117,3 +117,21 @@ def test_render_hair_none_and_long_differ_above_the_forehead(tmp_path):
     middle = np.s_[30:60, 36:60]
     assert np.abs(bald[middle] - haired[middle]).max() <= 2
     assert np.abs(bald - haired).mean() > 5  # while the hair changes the frame
+
+
+def test_check_and_batch_jobs_refuse_an_unknown_style(tmp_path, capsys):
+    from facelib.batch import RenderJob, plan_jobs, render_job
+    from facelib.mpeg4 import write_fap
+
+    story = tmp_path / "story.fdl"
+    story.write_text('show { "joy", at = 0, dur = 0.2 }\nhair = "tide"\n')
+    assert main(["check", str(story)]) == 1
+    assert f"{story}:2: hair style 'tide'" in capsys.readouterr().err
+    story.write_text('show { "joy", at = 0, dur = 0.2 }\nhair = "tied"\n')
+    assert main(["check", str(story)]) == 0
+    assert "hair: tied" in capsys.readouterr().out
+    assert [j.hair for j in plan_jobs([story], tmp_path, hair="long")] == ["long"]
+    fap = tmp_path / "still.fap"
+    write_fap(FapStream(25, np.zeros((1, 84), np.float32)), fap)
+    result = render_job(RenderJob(str(fap), str(tmp_path / "x.mp4"), hair="lnog"))
+    assert result.output is None and "did you mean 'long'?" in str(result.error)
