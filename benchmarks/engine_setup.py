@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from facelib.engine import default_face
-from facelib.engine.headmesh import HeadMesh, head_mesh, load_head_mesh
-from facelib.engine.setup import read_landmarks, set_up_face
-from facelib.engine.tps import fit_tps
+from facelib.engine.setup import read_landmarks, setup_face
+from facelib.engine.setup.headmesh import HeadMesh, head_mesh, load_head_mesh
+from facelib.engine.setup.tps import fit_tps
 
 HEADS = Path(__file__).resolve().parent.parent / "examples" / "heads"
 
@@ -66,7 +66,8 @@ def main() -> None:
         mesh = load_head_mesh(HEADS / mesh_name)
         landmarks = read_landmarks(HEADS / mark_name)
         for head in (mesh, subdivide(mesh)):
-            t = best_of(lambda h=head, m=landmarks: set_up_face(h, landmarks=m, source=source))
+            t = best_of(lambda h=head, m=landmarks: setup_face(h, landmarks=m, source=source,
+                                                               report=True))
             print(f"{head.name:<28} {len(head.vertices):>8} {len(head.triangles):>9} "
                   f"{t:>9.2f}")
 

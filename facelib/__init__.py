@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 from facelib import expressions, fdl, gaze, mpeg4, sync, visemes
 from facelib.animation import Animation, animate, run_fdl
 from facelib.errors import (
+    ArkitFormatError,
     DataError,
     FacelibError,
     FacelibWarning,
@@ -27,9 +28,12 @@ from facelib.errors import (
     FileError,
     MissingExtraError,
     ParameterError,
+    PronunciationWarning,
     RenderError,
     SpeechError,
     SpeechWarning,
+    TrackingError,
+    TrackingWarning,
     facelib_warnings,
 )
 from facelib.mpeg4 import FapStream, FapTrack, fap, feature_point, read_fap, write_fap
@@ -74,8 +78,14 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'facelib' has no attribute {name!r}")
 
 
+def __dir__() -> list[str]:
+    """The module's names and the lazy ones (so completion offers ``render`` before use)."""
+    return sorted({*globals(), *_LAZY})
+
+
 __all__ = [
     "Animation",
+    "ArkitFormatError",
     "DataError",
     "Face",
     "FaceModelError",
@@ -89,9 +99,12 @@ __all__ = [
     "FileError",
     "MissingExtraError",
     "ParameterError",
+    "PronunciationWarning",
     "RenderError",
     "SpeechError",
     "SpeechWarning",
+    "TrackingError",
+    "TrackingWarning",
     "__version__",
     "animate",
     "arkit_residuals",

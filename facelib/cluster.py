@@ -22,7 +22,8 @@ import struct
 from collections.abc import Iterator, Sequence
 from typing import Any
 
-from facelib.errors import FacelibError, FileError, MissingExtraError, ParameterError
+from facelib.errors import FacelibError, FileError, ParameterError
+from facelib.optional import missing_extra
 
 __all__ = ["MAX_MESSAGE_BYTES", "TASK_FAILED", "check_address", "decode_message",
            "open_client", "refused", "tls_security"]
@@ -256,7 +257,7 @@ def tls_security(*, ca: str, cert: str, key: str) -> Any:
     try:
         from distributed.security import Security
     except ImportError:
-        raise MissingExtraError("work on a Dask cluster", "scale", "distributed") from None
+        raise missing_extra("distributed") from None
     for what, path in (("--tls-ca", ca), ("--tls-cert", cert), ("--tls-key", key)):
         if not Path(path).is_file():
             raise FileError(f"{what}: not a readable file", path=path)
@@ -280,7 +281,7 @@ def open_client(scheduler: Any, *, security: Any = None, trust: bool = False,
     try:
         from distributed import Client
     except ImportError:
-        raise MissingExtraError("work on a Dask cluster", "scale", "distributed") from None
+        raise missing_extra("distributed") from None
     if isinstance(scheduler, Client):
         if trust:
             yield scheduler

@@ -22,7 +22,7 @@ import numpy as np
 from facelib.atomic import atomic_path, write_text_atomic
 from facelib.data import csv_rows
 from facelib.engine import Face, load_face
-from facelib.engine.registry import deformer_names
+from facelib.engine.deformers import deformer_names
 from facelib.engine.roughness import flipped_triangles, region_roughness, roughness_report
 from facelib.errors import DataError, ParameterError
 

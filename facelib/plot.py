@@ -13,9 +13,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from facelib.atomic import atomic_path
-from facelib.errors import MissingExtraError, ParameterError
+from facelib.errors import ParameterError
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap, fap_groups, fap_table
+from facelib.optional import require
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -53,13 +54,9 @@ def plot_curves(
         labelled, and the spoken span is marked).
     out: the file to write (atomically). Returns its path.
     """
-    try:
-        import matplotlib as mpl
-
-        mpl.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise MissingExtraError("plotting", "plot", "matplotlib") from exc
+    mpl = require("matplotlib")
+    mpl.use("Agg")
+    plt = require("pyplot")
     if not isinstance(source, FapStream) and not isinstance(getattr(source, "faps", None),
                                                             FapStream):
         raise ParameterError(f"plot_curves takes a FapStream or an Animation, not "

@@ -14,7 +14,7 @@ import pytest
 from facelib import fdl
 from facelib.atomic import output_folder
 from facelib.cli import main
-from facelib.engine.headmesh import head_mesh, load_head_mesh
+from facelib.engine.setup.headmesh import head_mesh, load_head_mesh
 from facelib.errors import FaceModelError, FdlError, FileError
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,7 +15,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "facelib"
 
-BASE = {"errors", "checks", "atomic", "data", "progress"}
+BASE = {"errors", "checks", "atomic", "data", "progress", "optional"}
 GENERATORS = {"fdl", "speech", "visemes", "expressions", "gaze"}
 OUTPUTS = {"rendering", "tracking", "export"}
 TOP = {"batch", "cluster", "dataset", "evaluate", "catalog", "cli", "plot", "__init__", "__main__"}
@@ -98,3 +98,39 @@ def test_the_checker_sees_lazy_and_relative_imports(tmp_path: Path) -> None:
     assert "rendering" not in ALLOWED["engine"]
     assert "clip" not in ALLOWED["engine"]
     assert not {"cues", "animation", "rendering", "export"} & ALLOWED["clip"]
+
+
+ENGINE = PACKAGE / "engine"
+# room of facelib/engine -> the rooms it may import (DESIGN.md: the engine's rooms)
+ENGINE_ROOMS: dict[str, set[str]] = {
+    "deformers": {"deformers"},
+    "core": {"core", "deformers"},
+    "setup": {"core", "deformers", "setup"},
+}
+
+
+def engine_room(module: str) -> str:
+    """``deformers``, ``setup`` or ``core`` for a module name under ``facelib.engine``."""
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 and parts[2] in ENGINE_ROOMS else "core"
+
+
+@pytest.mark.parametrize("path", sorted(ENGINE.rglob("*.py")),
+                         ids=lambda p: str(p.relative_to(ENGINE)))
+def test_engine_rooms_import_only_downward(path: Path) -> None:
+    package = ".".join(("facelib", *path.relative_to(PACKAGE).parent.parts))
+    own = engine_room(package)
+    wrong = [f"{path.name}:{line} imports {module} ({own} -> {engine_room(module)})"
+             for line, module in imports_of(path, package)
+             if module.startswith("facelib.engine")
+             and engine_room(module) not in ENGINE_ROOMS[own]]
+    assert not wrong, "\n".join(wrong)
+
+
+def test_engine_rooms_are_told_apart() -> None:
+    assert engine_room("facelib.engine") == engine_room("facelib.engine.face") == "core"
+    assert engine_room("facelib.engine.deformers") == "deformers"
+    assert engine_room("facelib.engine.deformers.rbf") == "deformers"
+    assert engine_room("facelib.engine.setup.tps") == "setup"
+    assert "setup" not in ENGINE_ROOMS["core"] | ENGINE_ROOMS["deformers"]
+    assert "core" not in ENGINE_ROOMS["deformers"]

@@ -202,8 +202,8 @@ def _smooth(values: np.ndarray, triangles: np.ndarray, rounds: int) -> np.ndarra
 
 def occlusion(face) -> np.ndarray:
     """``(V,) float64`` ambient occlusion in [0, 1] (1 = open sky) of a facelib ``Face``."""
+    from facelib.engine.surface import vertex_normals
     from facelib.mpeg4 import fap
-    from facelib.rendering.scene import vertex_normals
 
     directions = sphere_directions(DIRECTIONS)
     best = np.zeros(face.n_vertices)
@@ -217,7 +217,7 @@ def occlusion(face) -> np.ndarray:
         for part in face.parts.values():  # each part's own smooth normals, as rendered
             ids = part.vertex_ids
             local = np.searchsorted(ids, part.triangles)
-            normals[ids] = vertex_normals(vertices[ids], local)
+            normals[ids] = vertex_normals(vertices[ids], local, unused=(0.0, 0.0, 1.0))
         seen = visibility(vertices, face.triangles, normals, directions)
         weight = np.clip(normals @ directions.T, 0.0, None)
         open_sky = (seen * weight).sum(1) / np.maximum(weight.sum(1), 1e-9)

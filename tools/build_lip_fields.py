@@ -12,7 +12,7 @@ its upper and lower halves by what the jaw carries: a vertex's share in the lowe
 far the head's ``JawOpen`` target moves it relative to the lower-lip point 2.3 (1 on the lower
 lip and chin, 0 on the upper lip, in between at the corners), so the two halves add up to the
 whole target whatever the lips' shape at rest, and they are written as ``field`` regions (see
-:mod:`facelib.engine.fields`) into ``default_head.json`` and ``default_head.npz``. Rows
+:mod:`facelib.engine.deformers.fields`) into ``default_head.json`` and ``default_head.npz``. Rows
 already there are replaced. Deterministic; the other rows are left as built by
 ``tools/build_default_head.py``.
 """

@@ -47,9 +47,9 @@ import numpy as np
 
 from facelib.data import path as data_path
 from facelib.engine import Face, default_face
-from facelib.engine.headmesh import head_mesh
 from facelib.engine.setup import setup_face
-from facelib.engine.tps import fit_tps
+from facelib.engine.setup.headmesh import head_mesh
+from facelib.engine.setup.tps import fit_tps
 from facelib.expressions import default_library
 from facelib.mpeg4 import ANGLE_UNIT, FAPU_SCALE, N_FAPS, FapStream, fap, fap_table
 from facelib.tracking.closedloop import (

@@ -18,7 +18,7 @@ import numpy as np
 
 from facelib.animation import run_fdl
 from facelib.engine import default_face
-from facelib.engine.setup import set_up_face
+from facelib.engine.setup import setup_face
 from facelib.rendering.scene import FaceRenderer
 from facelib.rendering.video import save_png
 
@@ -51,8 +51,8 @@ def main(folder: str) -> None:
     heads = {"default head": (source, None)}
     for name, mesh in (("SOMA-X head", "soma_head.ply"), ("cartoon head", "cartoon_head.obj")):
         stem = mesh.split("_")[0]
-        result = set_up_face(HEADS / mesh, landmarks=HEADS / f"{stem}_landmarks.json",
-                             source=source)
+        result = setup_face(HEADS / mesh, landmarks=HEADS / f"{stem}_landmarks.json",
+                            source=source, report=True)
         heads[name] = (result.face, result)
     animation = run_fdl(ROOT / "examples" / "hello" / "hello.fdl")
     stream = animation.faps

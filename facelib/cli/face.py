@@ -54,8 +54,8 @@ def _write_found(found: Any, folder: Path, console: Console) -> None:
 
 
 def _face_setup(args: argparse.Namespace, console: Console) -> int:
-    from facelib.engine.headmesh import load_head_mesh
-    from facelib.engine.setup import set_up_face
+    from facelib.engine.setup import setup_face
+    from facelib.engine.setup.headmesh import load_head_mesh
     from facelib.engine.writer import write_face
 
     if (args.landmarks is None) == (not args.auto):
@@ -73,8 +73,8 @@ def _face_setup(args: argparse.Namespace, console: Console) -> int:
 
         found = detect_head_landmarks(mesh, up=args.up, forward=args.forward)
         landmarks = found.as_json()
-    result = set_up_face(mesh, landmarks=landmarks, unit=args.unit, up=args.up,
-                         forward=args.forward)
+    result = setup_face(mesh, landmarks=landmarks, unit=args.unit, up=args.up,
+                        forward=args.forward, report=True)
     out = write_face(result.face, Path(args.output) / "face.json", name=Path(args.mesh).stem,
                      source=f"facelib face setup {Path(args.mesh).name}")
     if found is not None:

@@ -17,6 +17,7 @@ import numpy as np
 
 from facelib import data
 from facelib.engine.attachments import attach, definition_hair_styles, read_attachments
+from facelib.engine.deformers import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.face import (
     ATTACHED_PARTS,
     OPTIONAL_PARTS,
@@ -26,7 +27,6 @@ from facelib.engine.face import (
     Region,
 )
 from facelib.engine.meshfile import mesh_path, read_npz
-from facelib.engine.registry import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FacelibError, FaceModelError, ParameterError
 from facelib.mpeg4.tables import fap, fap_table, feature_point_table

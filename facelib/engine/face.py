@@ -4,7 +4,7 @@ Deformation of one frame ``f`` (84 FAP values):
 
 1. every translational FAP moves its feature point by ``f_j * FAPU_j * direction_j``
    (eq. 4.6) and the regions controlled by that point carry the motion to their vertices
-   (each region's deformer from :mod:`facelib.engine.registry`: raised cosine, RBF,
+   (each region's deformer from :mod:`facelib.engine.deformers`: raised cosine, RBF,
    explicit weights, the second seed's interpolations); all of this is one sparse linear
    operator ``A (84, 3V)``, so ``positions = rest + f @ A``, plus the exact per-frame step of
    any frame-based region in ``mode="exact"``;
@@ -34,8 +34,8 @@ import scipy.sparse as sp
 
 from facelib.checks import check_count
 from facelib.engine import rigid
+from facelib.engine.deformers import Deformer, FrameStep, RegionSetup, deformer
 from facelib.engine.fapu import compute_fapu
-from facelib.engine.registry import Deformer, FrameStep, RegionSetup, deformer
 from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FaceModelError, ParameterError
 from facelib.mpeg4.highlevel import apply_high_level
@@ -98,7 +98,7 @@ class Region:
     """An influence region of the face definition.
 
     name: unique name.
-    deformer: a name of :mod:`facelib.engine.registry` (``raised_cosine``, ``rbf``,
+    deformer: a name of :mod:`facelib.engine.deformers` (``raised_cosine``, ``rbf``,
         ``weights``, ...) or ``"eyelid"`` (rotation over the eye).
     feature_points: ids of the controlling feature points.
     vertices: (Vr,) int32 member vertices (the ones that move).
@@ -107,7 +107,7 @@ class Region:
     pivot: pivot name (``eyelid`` only).
     params: the deformer's parameters as the definition (or an override) gives them.
     group: an optional group name (``"lips"``) that overrides may use instead of the name.
-    custom: a :class:`~facelib.engine.registry.Deformer` given directly instead of a name.
+    custom: a :class:`~facelib.engine.deformers.Deformer` given directly instead of a name.
     displacements: (Vr, 3) float32 learned target displacements of the members (``field``
         regions, which name their FAP in ``params["fap"]``; empty otherwise).
     """

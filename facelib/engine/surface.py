@@ -38,15 +38,25 @@ def triangle_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
-def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Area-weighted unit vertex normals ``(V, 3)`` float64; 0 for unused vertices."""
+def vertex_normals(vertices: np.ndarray, triangles: np.ndarray, *,
+                   unused: tuple[float, float, float] | None = None) -> np.ndarray:
+    """Area-weighted unit vertex normals ``(V, 3)`` float64 (the one facelib computes).
+
+    vertices: (V, 3) float positions; triangles: (F, 3) int, counter-clockwise = outside.
+    Each vertex sums the unnormalised normals of its triangles (their length is twice the
+    area). A vertex of no triangle (or whose sum is zero) gets 0, or ``unused`` when given
+    (the renderer and the glTF export give ``(0, 0, 1)``).
+    """
     v = np.asarray(vertices, dtype=np.float64)
-    n = np.cross(v[triangles[:, 1]] - v[triangles[:, 0]], v[triangles[:, 2]] - v[triangles[:, 0]])
-    out = np.zeros_like(v)
-    for corner in range(3):
-        np.add.at(out, triangles[:, corner], n)
+    t = np.asarray(triangles, dtype=np.int64)
+    n = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
+    # summed corner by corner in triangle order (bincount adds in input order)
+    corners, per_corner = t.T.ravel(), np.tile(n, (3, 1))
+    out = np.stack([np.bincount(corners, per_corner[:, k], minlength=len(v)) for k in range(3)],
+                   axis=1)
     length = np.linalg.norm(out, axis=1, keepdims=True)
-    return np.divide(out, length, out=np.zeros_like(out), where=length > 0)
+    fill = np.zeros(3) if unused is None else np.asarray(unused, np.float64)
+    return np.where(length > 0, out / np.where(length > 0, length, 1.0), fill)
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,13 +20,14 @@ from facelib import data
 from facelib.atomic import atomic_path
 from facelib.engine import Face, Part, default_face, surface
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
-from facelib.errors import MissingExtraError, ParameterError
+from facelib.errors import ParameterError
 from facelib.export.audio import copy_audio
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, export_clip, face_of
 from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
+from facelib.optional import require
 
 __all__ = ["GltfExport", "export_gltf", "primitive_vertex_ids"]
 
@@ -150,11 +151,7 @@ def _target_name(row: int, scale: float) -> str:
 
 
 def _import_pygltflib() -> Any:
-    try:
-        import pygltflib
-    except ImportError as exc:
-        raise MissingExtraError("glTF export", "export", "pygltflib") from exc
-    return pygltflib
+    return require("pygltflib")
 
 
 def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarray:
@@ -174,11 +171,9 @@ def _occluded(linear: np.ndarray, face: Face, look: dict[str, Any]) -> np.ndarra
     return out
 
 
-def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """(V, 3) float32 unit area-weighted vertex normals ((0, 0, 1) where undefined)."""
-    out = surface.vertex_normals(vertices, triangles)
-    out[~out.any(axis=1)] = (0.0, 0.0, 1.0)
-    return out.astype(np.float32)
+def _normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(V, 3) float32 :func:`~facelib.engine.surface.vertex_normals` ((0, 0, 1) if undefined)."""
+    return surface.vertex_normals(vertices, triangles, unused=(0.0, 0.0, 1.0)).astype(np.float32)
 
 
 def primitive_vertex_ids(part: Part) -> np.ndarray:
@@ -197,9 +192,9 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     lib = b.lib
     look_data = data.json_data("render_look.json")
     look = look_data["parts"]
-    normals = vertex_normals(face.vertices, face.triangles)
+    normals = _normals(face.vertices, face.triangles)
     # each target's change of the normals, so that players shade the deformed face right
-    normal_turns = [vertex_normals(face.vertices + disp, face.triangles) - normals
+    normal_turns = [_normals(face.vertices + disp, face.triangles) - normals
                     for disp in targets]
     colours = _occluded(srgb_to_linear(face.vertex_colors), face, look_data)  # glTF's: linear
     joints = np.zeros((face.n_vertices, 4), np.uint16)

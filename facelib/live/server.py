@@ -29,9 +29,10 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from typing import Any
 
-from facelib.errors import FacelibError, MissingExtraError, ParameterError
+from facelib.errors import FacelibError, ParameterError
 from facelib.live.session import OUTPUT_RATE, Output, Session
 from facelib.live.udp import parse_target
+from facelib.optional import require
 
 __all__ = ["HARD_MESSAGE_BYTES", "MAX_MESSAGE_BYTES", "ServerOptions", "frame_message",
            "serve", "start_server"]
@@ -80,11 +81,7 @@ def _is_loopback(host: str) -> bool:
 
 
 def _websockets() -> Any:
-    try:
-        from websockets.asyncio import server
-    except ImportError as exc:
-        raise MissingExtraError("facelib serve", "live", "websockets") from exc
-    return server
+    return require("websockets")
 
 
 def frame_message(out: Output, outputs: set[str]) -> dict[str, Any]:

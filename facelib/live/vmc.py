@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from facelib.errors import MissingExtraError, ParameterError
+from facelib.errors import ParameterError
+from facelib.optional import require
 
 __all__ = ["DEFAULT_PORT", "VOWELS", "bundle", "clip_values", "head_quaternion"]
 
@@ -28,11 +29,7 @@ _PRESETS = ("A", "I", "U", "E", "O", "Blink_L", "Blink_R")
 
 
 def _osc() -> Any:
-    try:
-        from pythonosc import osc_bundle_builder, osc_message_builder
-    except ImportError as exc:
-        raise MissingExtraError("VMC output", "live", "python-osc") from exc
-    return osc_bundle_builder, osc_message_builder
+    return require("osc_bundle"), require("osc_message")
 
 
 def clip_values(weights: np.ndarray, viseme: int) -> list[tuple[str, float]]:

@@ -25,7 +25,8 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-from facelib.errors import MissingExtraError, RenderError
+from facelib.errors import RenderError
+from facelib.optional import missing_extra, require
 
 __all__ = ["INSTALL_HINT", "choose_platform", "import_pyrender"]
 
@@ -109,15 +110,12 @@ def import_pyrender(*, offscreen: bool = True) -> ModuleType:
     """
     if offscreen:
         choose_platform()
-    try:
-        import OpenGL  # noqa: F401  (PyOpenGL, the platform binding)
-    except ImportError as exc:
-        raise MissingExtraError("rendering", "render", "PyOpenGL") from exc
+    require("opengl")  # PyOpenGL, the platform binding
     try:
         import pyrender
     except ImportError as exc:
         if "pyrender" in str(exc) and getattr(exc, "name", "") == "pyrender":
-            raise MissingExtraError("rendering", "render", "pyrender2") from exc
+            raise missing_extra("pyrender") from exc
         raise RenderError(f"pyrender could not load its OpenGL platform ({exc}); {INSTALL_HINT}") \
             from exc
     except Exception as exc:  # PyOpenGL raises plain errors when a platform library is absent

@@ -21,7 +21,8 @@ import numpy as np
 
 from facelib.atomic import atomic_path, publish, temp_beside
 from facelib.checks import check_fps, check_sample_rate
-from facelib.errors import MissingExtraError, ParameterError, RenderError
+from facelib.errors import ParameterError, RenderError
+from facelib.optional import require
 
 __all__ = [
     "FrameWriter",
@@ -88,10 +89,7 @@ def save_png(image: np.ndarray, path: str | os.PathLike[str]) -> Path:
 
 def ffmpeg_exe() -> str:
     """Path of the ffmpeg binary shipped by ``imageio-ffmpeg``."""
-    try:
-        import imageio_ffmpeg
-    except ImportError as exc:
-        raise MissingExtraError("video writing", "render", "imageio-ffmpeg") from exc
+    imageio_ffmpeg = require("ffmpeg_render")
     try:
         return imageio_ffmpeg.get_ffmpeg_exe()
     except RuntimeError as exc:

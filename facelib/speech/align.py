@@ -20,6 +20,7 @@ from typing import Any, Literal
 import numpy as np
 
 from facelib.errors import ParameterError, PronunciationWarning, SpeechError, SpeechWarning
+from facelib.optional import require
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.pronounce import model_dir, pronounce, tokenize
 from facelib.speech.tables import alignment_settings, phone_durations
@@ -38,12 +39,7 @@ def _decoder(*, wide: bool = False) -> Any:
     """A new pocketsphinx decoder (``wide``: with the wide beams of alignment.json). Not
     kept: a decoder holds on to the memory of its last search (gigabytes after a long
     recording), so each alignment loads the model afresh (about a second) and frees it."""
-    try:
-        from pocketsphinx import Decoder
-    except ImportError as exc:
-        from facelib.errors import MissingExtraError
-
-        raise MissingExtraError("speech alignment", "speech", "pocketsphinx") from exc
+    Decoder = require("pocketsphinx").Decoder  # noqa: N806
     settings = alignment_settings()
     beams = settings["wide_beams"] if wide else {}
     decoder = Decoder(bestpath=False, loglevel="FATAL", frate=1000 // settings["frame_ms"],

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.errors import MissingExtraError, SpeechError
+from facelib.errors import SpeechError
+from facelib.optional import require
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.synth import DEFAULT_LANGUAGE, Synthesis, synthesize_many, voice_for
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Span, append_span, cover
@@ -48,10 +49,7 @@ def mfcc_features(samples: np.ndarray) -> np.ndarray:
     normalised to zero mean and unit variance over the signal (so voices and recording
     levels compare). Computed in blocks of a minute, so a long recording never needs its
     whole spectrogram at once."""
-    try:
-        import librosa
-    except ImportError as exc:
-        raise MissingExtraError("alignment in any language", "speech", "librosa") from exc
+    librosa = require("librosa")
     hop = ALIGN_RATE * HOP_MS // 1000
     n_fft = 512
     x = np.asarray(samples, np.float32).reshape(-1)

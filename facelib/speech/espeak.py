@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.errors import MissingExtraError, SpeechError
+from facelib.errors import SpeechError
+from facelib.optional import require
 from facelib.speech import espeak_worker
 
 __all__ = ["EspeakEvent", "EspeakVoice", "RawSynthesis", "Worker", "default_words_per_minute",
@@ -70,10 +71,7 @@ class EspeakVoice:
 
 
 def _check_installed() -> None:
-    try:
-        import espeakng_loader  # noqa: F401
-    except ImportError as exc:
-        raise MissingExtraError("speech synthesis", "speech", "espeakng-loader") from exc
+    require("espeak")
 
 
 class Worker:

@@ -10,7 +10,8 @@ import re
 from decimal import Decimal
 from functools import cache
 
-from facelib.errors import MissingExtraError, ParameterError
+from facelib.errors import ParameterError
+from facelib.optional import require
 
 __all__ = ["num2words_language", "spell_numbers", "to_ascii"]
 
@@ -26,11 +27,7 @@ _DECIMAL_COMMA = frozenset(("de", "es", "fr", "it", "pt", "pt_BR", "nl", "pl", "
 
 @cache
 def _num2words_languages() -> frozenset[str]:
-    try:
-        from num2words import CONVERTER_CLASSES
-    except ImportError as exc:
-        raise MissingExtraError("text normalisation", "speech", "num2words") from exc
-    return frozenset(CONVERTER_CLASSES)
+    return frozenset(require("num2words").CONVERTER_CLASSES)
 
 
 def num2words_language(lang: str) -> str | None:
@@ -78,10 +75,7 @@ def spell_numbers(text: str, *, lang: str) -> str:
 
 def to_ascii(text: str) -> str:
     """``text`` transliterated to ASCII by anyascii (``"José"`` -> ``"Jose"``)."""
-    try:
-        from anyascii import anyascii
-    except ImportError as exc:
-        raise MissingExtraError("text normalisation", "speech", "anyascii") from exc
+    anyascii = require("anyascii").anyascii
     if not isinstance(text, str):
         raise ParameterError(f"text must be a string, got {type(text).__name__}")
     return str(anyascii(text))

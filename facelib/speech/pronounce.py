@@ -10,6 +10,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from facelib.errors import MissingExtraError, SpeechError
+from facelib.optional import require
 from facelib.speech.normalize import spell_numbers, to_ascii
 from facelib.speech.tables import letter_to_sound_rules
 
@@ -42,10 +43,7 @@ def tokenize(text: str) -> list[str]:
 
 def model_dir() -> Path:
     """The pocketsphinx model folder (``en-us/``, ``cmudict-en-us.dict``, phone LM)."""
-    try:
-        import pocketsphinx
-    except ImportError as exc:
-        raise MissingExtraError("speech alignment", "speech", "pocketsphinx") from exc
+    pocketsphinx = require("pocketsphinx")
     return Path(pocketsphinx.get_model_path()) / "en-us"
 
 

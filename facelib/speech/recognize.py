@@ -21,6 +21,7 @@ from typing import Any, Literal
 import numpy as np
 
 from facelib.errors import ParameterError, SpeechError
+from facelib.optional import require
 from facelib.speech.align import _decode, _forced, _phone_loop, tokenize_words
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.tables import alignment_settings, recognition_settings
@@ -155,12 +156,7 @@ def decode_words(samples: np.ndarray) -> list[tuple[str, float]]:
 def _word_decoder(settings: Any) -> Any:
     """A new pocketsphinx decoder with the wheel's language model and a word lattice (for
     the posteriors); not kept, like the aligner's."""
-    try:
-        from pocketsphinx import Decoder
-    except ImportError as exc:
-        from facelib.errors import MissingExtraError
-
-        raise MissingExtraError("speech recognition", "speech", "pocketsphinx") from exc
+    Decoder = require("recognition").Decoder  # noqa: N806
     return Decoder(bestpath=True, loglevel="FATAL", frate=round(1000 / settings["frame_ms"]),
                    wlen=settings["window_ms"] / 1000, lw=settings["language_weight"])
 

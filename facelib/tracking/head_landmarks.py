@@ -26,7 +26,7 @@ from typing import cast
 
 import numpy as np
 
-from facelib.engine.headmesh import HeadMesh, axes_rotation
+from facelib.engine.setup.headmesh import HeadMesh, axes_rotation
 from facelib.errors import FaceModelError, TrackingError
 
 __all__ = ["AUTO_EXCLUDED", "HeadLandmarks", "detect_head_landmarks", "draw_landmarks"]
@@ -157,9 +157,9 @@ def detect_head_landmarks(mesh: HeadMesh, *, up: str | None = None,
     """Find feature points on a head mesh (see the module docstring).
 
     up, forward: the mesh's axes ("+x" ... "-z", as for
-        :func:`~facelib.engine.headmesh.axes_rotation`) when it is not upright (+y up)
+        :func:`~facelib.engine.setup.headmesh.axes_rotation`) when it is not upright (+y up)
         looking along +z; the mesh is turned upright for the search and the points are given
-        in the mesh's own frame, so they go with the same axes to ``set_up_face(mesh,
+        in the mesh's own frame, so they go with the same axes to ``setup_face(mesh,
         landmarks=found.as_json(), up=up, forward=forward)``. Default: upright.
     feature_points: the ids wanted (default: the default head's feature points); those in
         ``AUTO_EXCLUDED`` and the ones the MediaPipe table does not map are left out.

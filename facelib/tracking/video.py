@@ -22,7 +22,8 @@ from typing import Any
 import numpy as np
 
 from facelib.checks import check_count
-from facelib.errors import MissingExtraError, TrackingError, TrackingWarning
+from facelib.errors import TrackingError, TrackingWarning
+from facelib.optional import require
 from facelib.tracking.browimage import track_brows
 from facelib.tracking.faps import TrackedFaps, find_neutral, frame_spans, measure_faps
 from facelib.tracking.headframe import face_found
@@ -113,11 +114,7 @@ def _face_light(image: np.ndarray, box: np.ndarray) -> float:
 
 
 def _imageio_ffmpeg() -> Any:
-    try:
-        import imageio_ffmpeg
-    except ImportError as exc:
-        raise MissingExtraError("video input", "track", "imageio-ffmpeg") from exc
-    return imageio_ffmpeg
+    return require("ffmpeg_track")
 
 
 def _not_turned(record: logging.LogRecord) -> bool:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facelib.engine.deformers import raised_cosine_weights, rbf_weights
+from facelib.engine.deformers.linear import raised_cosine_weights, rbf_weights
 from facelib.errors import FaceModelError
 
 

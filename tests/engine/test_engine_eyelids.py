@@ -1,4 +1,4 @@
-"""Upper eyelids refitted to close over a transferred face's eye (engine.eyelids)."""
+"""Upper eyelids refitted to close over a transferred face's eye (engine.setup.eyelids)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from facelib.engine import default_face
-from facelib.engine.eyelids import close_upper_lid, eye_opening
 from facelib.engine.setup import read_landmarks, setup_face
+from facelib.engine.setup.eyelids import close_upper_lid, eye_opening
 
 HEADS = Path(__file__).resolve().parents[2] / "examples" / "heads"
 CLOSED = np.zeros(84, np.float32)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from facelib import engine
-from facelib.engine.fields import field_weights
+from facelib.engine.deformers.fields import field_weights
 from facelib.errors import FaceModelError
 from facelib.mpeg4.tables import fap
 

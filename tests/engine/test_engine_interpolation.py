@@ -10,15 +10,15 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from facelib.engine import load_face
-from facelib.engine.frame_deformers import frame_map, linearise
-from facelib.engine.interpolation import (
+from facelib.engine.deformers import RegionSetup, deformer
+from facelib.engine.deformers.frames import frame_map, linearise
+from facelib.engine.deformers.interpolation import (
     barycentric_weights,
     feature_point_weights,
     inverse_distance_weights,
     kshirsagar_weight,
 )
-from facelib.engine.rbf import interpolation_weights, warp
-from facelib.engine.registry import RegionSetup, deformer
+from facelib.engine.deformers.rbf import interpolation_weights, warp
 from facelib.errors import FaceModelError
 from facelib.mpeg4.tables import fap_table
 
@@ -169,7 +169,7 @@ def test_l4_linearised_head_agrees_with_exact_step_for_small_motion(kind: str) -
 
 
 def test_t8_rbf_defaults_reproduce_the_thesis_multiquadric() -> None:
-    from facelib.engine.deformers import rbf_weights
+    from facelib.engine.deformers.linear import rbf_weights
 
     rng = np.random.default_rng(11)
     controls, anchors, members = (rng.normal(size=(k, 3)) for k in (6, 20, 50))

@@ -14,7 +14,7 @@ import pytest
 
 from facelib.cli import main
 from facelib.engine import load_face
-from facelib.engine.headmesh import head_mesh, load_head_mesh
+from facelib.engine.setup.headmesh import head_mesh, load_head_mesh
 
 pytest.importorskip("trimesh")
 

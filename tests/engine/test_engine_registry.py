@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from facelib.engine import Face, load_face
-from facelib.engine.registry import Deformer, RegionSetup, deformer, deformer_names
+from facelib.engine.deformers import Deformer, RegionSetup, deformer, deformer_names
 from facelib.errors import FaceModelError, ParameterError
 
 

@@ -11,11 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import facelib
 from facelib.cli import main
-from facelib.engine import default_face, load_face
+from facelib.engine import Face, default_face, load_face
 from facelib.engine.face import PART_NAMES
-from facelib.engine.headmesh import head_mesh, load_head_mesh
 from facelib.engine.setup import read_landmarks, set_up_face, setup_face
+from facelib.engine.setup.headmesh import head_mesh, load_head_mesh
 from facelib.errors import FaceModelError, ParameterError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -71,7 +72,8 @@ def test_mesh_files_load_with_their_parts(tmp_path: Path, source) -> None:  # ty
     mesh = load_head_mesh(path, parts={"teeth_upper": "TeethUp", "teeth_lower": "TeethLow"})
     assert {k: v.size for k, v in mesh.parts.items()} == {
         k: source.parts[k].vertex_ids.size for k in PART_NAMES}
-    result = set_up_face(mesh, landmarks=_skin_marks(source, points=True), source=source)
+    result = setup_face(mesh, landmarks=_skin_marks(source, points=True), source=source,
+                        report=True)
     assert result.carried == ("lashes",)  # lashes always come from the source
     eye = result.face.parts["eye_l"].vertex_ids
     assert np.allclose(result.face.vertices[eye].mean(axis=0), source.vertices[
@@ -82,8 +84,14 @@ def test_unit_is_detected_or_checked(cartoon) -> None:  # type: ignore[no-untype
     mesh, marks = cartoon
     in_mm = head_mesh(mesh.vertices * 1000, mesh.triangles)
     marks_mm = {k: [c * 1000 for c in v] for k, v in marks.items()}
-    result = set_up_face(in_mm, landmarks=marks_mm)
+    result = setup_face(in_mm, landmarks=marks_mm, report=True)
     assert result.unit == "mm"
+    # the older name gives the same report; the public one without report=True the Face
+    older = set_up_face(in_mm, landmarks=marks_mm)
+    np.testing.assert_array_equal(older.face.vertices, result.face.vertices)
+    plain = facelib.setup_face(in_mm, landmarks=marks_mm)
+    assert isinstance(plain, Face)
+    np.testing.assert_array_equal(plain.vertices, result.face.vertices)
     assert np.ptp(result.face.vertices[:, 1]) == pytest.approx(np.ptp(mesh.vertices[:, 1]),
                                                                rel=1e-6)
     with pytest.raises(FaceModelError, match="looks like it is in mm"):
@@ -187,13 +195,13 @@ def test_given_axes_turn_a_z_up_mesh(cartoon, tmp_path: Path) -> None:  # type: 
     to_cad = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
     cad = mesh.rotated(to_cad)
     cad_marks = {k: (to_cad @ np.asarray(v)).tolist() for k, v in marks.items()}
-    upright = set_up_face(mesh, landmarks=marks).face
-    given = set_up_face(cad, landmarks=cad_marks, up="+z", forward="-y")
+    upright = setup_face(mesh, landmarks=marks)
+    given = setup_face(cad, landmarks=cad_marks, up="+z", forward="-y", report=True)
     np.testing.assert_allclose(given.rotation, to_cad.T, atol=1e-12)
     np.testing.assert_allclose(given.face.vertices, upright.vertices, atol=1e-6)
     # guessed: the best rotation onto the default head's feature points, a few degrees
     # from the true one since the cartoon has other proportions
-    guessed = set_up_face(cad, landmarks=cad_marks).rotation @ to_cad
+    guessed = setup_face(cad, landmarks=cad_marks, report=True).rotation @ to_cad
     assert np.degrees(np.arccos((np.trace(guessed) - 1) / 2)) < 5
     with pytest.raises(ParameterError, match="right angles"):
         setup_face(cad, landmarks=cad_marks, up="+z", forward="-z")

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from facelib.engine import default_face
+from facelib.engine.setup.tps import fit_tps
 from facelib.engine.surface import (
     barycentric,
     closest_on_triangles,
@@ -14,7 +15,6 @@ from facelib.engine.surface import (
     surface,
     vertex_normals,
 )
-from facelib.engine.tps import fit_tps
 from facelib.errors import FaceModelError
 
 
@@ -161,7 +161,7 @@ def test_d2_normal_check_skips_facing_away(face) -> None:  # type: ignore[no-unt
 
 
 def test_tps_agrees_with_the_shared_rbf_warp(landmarks) -> None:  # type: ignore[no-untyped-def]
-    from facelib.engine.rbf import warp
+    from facelib.engine.deformers.rbf import warp
 
     target = _moved(landmarks)
     rng = np.random.default_rng(9)

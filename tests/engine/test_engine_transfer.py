@@ -11,11 +11,11 @@ import pytest
 
 from facelib.engine import default_face, load_face
 from facelib.engine.face import ATTACHED_PARTS, PART_NAMES
-from facelib.engine.headmesh import head_mesh, load_head_mesh
 from facelib.engine.quality import mean_roughness
-from facelib.engine.setup import read_landmarks, set_up_face, setup_face
+from facelib.engine.setup import read_landmarks, setup_face
+from facelib.engine.setup.headmesh import head_mesh, load_head_mesh
+from facelib.engine.setup.tps import fit_tps
 from facelib.engine.surface import closest_points, surface, vertex_normals
-from facelib.engine.tps import fit_tps
 from facelib.engine.writer import write_face
 from facelib.visemes.tables import viseme_targets
 
@@ -108,7 +108,7 @@ def test_x2_similarity_copy_scales_everything(source) -> None:  # type: ignore[n
     tris = perm[source.triangles[source.triangles.max(axis=1) < n]]
     mesh = head_mesh(verts, tris, parts={p: perm[source.parts[p].vertex_ids] for p in PART_NAMES})
     marks = {k: int(perm[v]) for k, v in source.feature_points.items()}
-    result = set_up_face(mesh, landmarks=marks, source=source)
+    result = setup_face(mesh, landmarks=marks, source=source, report=True)
     face = result.face
     assert result.unit == "m"
     for unit in ("IRISD", "ES", "ENS", "MNS", "MW"):
@@ -134,8 +134,8 @@ def test_x2_rotated_copy_is_turned_upright(source) -> None:  # type: ignore[no-u
                     [-np.sin(angle), 0, np.cos(angle)]])
     n = _own(source)
     verts = source.vertices[:n].astype(np.float64) @ rot.T * 1.3
-    result = set_up_face(_mesh_of(source, verts), landmarks=_all_landmarks(source),
-                         source=source)
+    result = setup_face(_mesh_of(source, verts), landmarks=_all_landmarks(source),
+                        source=source, report=True)
     np.testing.assert_allclose(result.rotation, rot.T, atol=1e-9)
     face = result.face
     for name in ("jaw", "smile", "yaw"):
@@ -212,7 +212,7 @@ def test_x4_d3_noise_on_the_target(source) -> None:  # type: ignore[no-untyped-d
 def soma(source, tmp_path_factory):  # type: ignore[no-untyped-def]
     marks = read_landmarks(HEADS / "soma_landmarks.json")
     given = {k: v for k, v in marks.items() if k not in HELD_OUT}
-    result = set_up_face(HEADS / "soma_head.ply", landmarks=given, source=source)
+    result = setup_face(HEADS / "soma_head.ply", landmarks=given, source=source, report=True)
     path = write_face(result.face, tmp_path_factory.mktemp("soma") / "face.json")
     return result, load_face(path), marks
 

@@ -16,7 +16,7 @@ import pytest
 
 pytest.importorskip("trimesh")
 
-from facelib.engine.headmesh import load_head_mesh
+from facelib.engine.setup.headmesh import load_head_mesh
 from facelib.errors import FaceModelError
 
 VERTS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], np.float32)

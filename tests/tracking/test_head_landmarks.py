@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from facelib.engine.headmesh import axes_rotation, head_mesh, load_head_mesh
-from facelib.engine.setup import read_landmarks, set_up_face
+from facelib.engine.setup import read_landmarks, setup_face
+from facelib.engine.setup.headmesh import axes_rotation, head_mesh, load_head_mesh
 from facelib.errors import FaceModelError
 
 pytest.importorskip("mediapipe")
@@ -70,15 +70,15 @@ def test_a_mesh_lying_on_its_back_is_searched_upright_and_answered_in_its_own_fr
     assert found.points.keys() == reference.points.keys()
     for fp, point in found.points.items():  # the same search, the points in lying's frame
         np.testing.assert_array_equal(point, turn.T @ reference.points[fp])
-    face = set_up_face(lying, landmarks=found.as_json(), up="+z", forward="-y").face
+    face = setup_face(lying, landmarks=found.as_json(), up="+z", forward="-y")
     np.testing.assert_allclose(
-        face.vertices, set_up_face(upright, landmarks=reference.as_json()).face.vertices,
+        face.vertices, setup_face(upright, landmarks=reference.as_json()).vertices,
         atol=1e-6)
 
 def test_auto_landmarks_set_up_a_face() -> None:
     mesh = load_head_mesh(HEADS / "soma_head.ply")
     found = detect_head_landmarks(mesh)
-    face = set_up_face(mesh, landmarks=found.as_json()).face
+    face = setup_face(mesh, landmarks=found.as_json())
     fp = face.feature_points
     # the lips part where they should: the inner upper lip above the inner lower lip
     assert face.vertices[fp["2.2"], 1] > face.vertices[fp["2.3"], 1]
@@ -106,7 +106,7 @@ def test_auto_landmarks_set_up_the_cartoon() -> None:
     nothing (ear_back_r onto its feature point alone, which failed the set-up): such a
     region takes the target vertices around where the warp puts it."""
     mesh = load_head_mesh(HEADS / "cartoon_head.obj")
-    face = set_up_face(mesh, landmarks=detect_head_landmarks(mesh).as_json()).face
+    face = setup_face(mesh, landmarks=detect_head_landmarks(mesh).as_json())
     for region in face.regions:
         assert region.vertices.size >= 2, region.name
     ears = {r.name: r for r in face.regions}["ear_back_r"]

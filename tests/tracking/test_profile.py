@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from facelib.engine import default_face
-from facelib.engine.headmesh import load_head_mesh
 from facelib.engine.setup import read_landmarks
+from facelib.engine.setup.headmesh import load_head_mesh
 from facelib.errors import FaceModelError
 from facelib.tracking.profile import PROFILE_POINTS, midline_profile, profile_points
 

@@ -17,8 +17,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra
 
-from facelib.engine.control_mesh import control_mesh
-from facelib.engine.registry import Deformer, RegionSetup
+from facelib.engine.deformers.base import Deformer, RegionSetup
+from facelib.engine.deformers.control_mesh import control_mesh
 
 __all__ = ["DEFORMERS", "barycentric_weights", "feature_point_weights",
            "inverse_distance_weights", "kshirsagar_weight"]

@@ -2,7 +2,7 @@
 
 ``setup_face(mesh, landmarks=...)`` finds the mesh's unit and orientation from the
 landmarks, fits the thin-plate spline from the source face's feature points to them, and
-transfers the source's whole face definition (see :mod:`facelib.engine.transfer`).
+transfers the source's whole face definition (see :mod:`facelib.engine.setup.transfer`).
 ``write_face`` stores the result as a normal face definition JSON plus mesh.
 """
 
@@ -13,19 +13,22 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 
 from facelib.engine.definition import default_face
 from facelib.engine.face import Face
-from facelib.engine.headmesh import HeadMesh, axes_rotation, load_head_mesh
+from facelib.engine.setup.headmesh import HeadMesh, axes_rotation, load_head_mesh
+from facelib.engine.setup.tps import ThinPlateSpline, check_landmarks, fit_tps
+from facelib.engine.setup.transfer import transfer_face
 from facelib.engine.surface import Surface, closest_points, surface
-from facelib.engine.tps import ThinPlateSpline, check_landmarks, fit_tps
-from facelib.engine.transfer import transfer_face
 from facelib.errors import FaceModelError, ParameterError
 
-__all__ = ["UNITS", "FaceSetup", "read_landmarks", "set_up_face", "setup_face"]
+__all__ = ["UNITS", "FaceSetup", "read_landmarks", "setup_face"]
+
+_Mesh = HeadMesh | str | Path
+_Marks = Mapping[str, Any] | str | Path
 
 # length units a head mesh may come in: metres per unit
 UNITS = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001, "in": 0.0254}
@@ -35,7 +38,7 @@ _OFF_SURFACE = 0.03  # a landmark this far off the mesh (x the landmarks' extent
 
 @dataclass(frozen=True, eq=False)
 class FaceSetup:
-    """The result of :func:`set_up_face`.
+    """What ``setup_face(..., report=True)`` returns: the Face and how it was made.
 
     face: the new Face (metres, facelib's face frame).
     unit: the mesh unit used (a key of ``UNITS``).
@@ -135,7 +138,7 @@ def set_up_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | s
                 source: Face | None = None, unit: str | None = None,
                 up: str | None = None, forward: str | None = None,
                 min_normal_cos: float = 0.5) -> FaceSetup:
-    """Set a head mesh up for animation; see :func:`setup_face`. Returns a :class:`FaceSetup`."""
+    """``setup_face(..., report=True)`` by its older name (docs/own-head.md showed it)."""
     src = default_face() if source is None else source
     head = mesh if isinstance(mesh, HeadMesh) else load_head_mesh(mesh)
     marks = read_landmarks(landmarks) if isinstance(landmarks, (str, Path)) else landmarks
@@ -182,10 +185,21 @@ def _residuals(skin: Surface, ids: Sequence[str], points: np.ndarray, src: Face)
     return dist
 
 
-def setup_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | str | Path,
-               source: Face | None = None, unit: str | None = None,
-               up: str | None = None, forward: str | None = None,
-               min_normal_cos: float = 0.5) -> Face:
+@overload
+def setup_face(mesh: _Mesh, *, landmarks: _Marks, source: Face | None = ...,
+               unit: str | None = ..., up: str | None = ..., forward: str | None = ...,
+               min_normal_cos: float = ..., report: Literal[False] = ...) -> Face: ...
+
+
+@overload
+def setup_face(mesh: _Mesh, *, landmarks: _Marks, source: Face | None = ...,
+               unit: str | None = ..., up: str | None = ..., forward: str | None = ...,
+               min_normal_cos: float = ..., report: Literal[True]) -> FaceSetup: ...
+
+
+def setup_face(mesh: _Mesh, *, landmarks: _Marks, source: Face | None = None,
+               unit: str | None = None, up: str | None = None, forward: str | None = None,
+               min_normal_cos: float = 0.5, report: bool = False) -> Face | FaceSetup:
     """Make a head mesh animatable: the source's face definition transferred onto it.
 
     Parameters
@@ -200,6 +214,8 @@ def setup_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | st
     up, forward: the mesh's up axis and the way its face looks (``"+z"``, ``"-y"``, ...);
         when both are None the orientation is guessed from the landmarks.
     min_normal_cos: the normal check of the closest-point steps.
+    report: return a :class:`FaceSetup` (the Face with the unit, rotation, carried parts,
+        landmark residuals and fitted warp) instead of the Face alone.
 
     Returns a Face in metres in facelib's face frame (a mesh whose landmarks are rotated
     more than 5 degrees from it is turned upright).
@@ -207,6 +223,7 @@ def setup_face(mesh: HeadMesh | str | Path, *, landmarks: Mapping[str, Any] | st
     Raises FaceModelError for a non-manifold or unwelded mesh, too few, duplicate or
     coplanar landmarks, a landmark off the surface, or a mesh in the wrong unit.
     """
-    return set_up_face(mesh, landmarks=landmarks, source=source, unit=unit, up=up,
-                       forward=forward, min_normal_cos=min_normal_cos).face
+    result = set_up_face(mesh, landmarks=landmarks, source=source, unit=unit, up=up,
+                         forward=forward, min_normal_cos=min_normal_cos)
+    return result if report else result.face
 

@@ -11,7 +11,7 @@ and the side condition ``P^T W = 0`` (eq. 4.2-4.5). The system is solved by
 space of functions; ``"thin_plate_spline"``, ``r^2 log r``, the two-dimensional kernel, is
 offered as an option). The coefficients ``W`` and ``A`` are read back in the seed's
 convention for the analytic Jacobian and the bending energy. The general RBF weights of the
-deformers (any kernel, fitted on the identity) are :mod:`facelib.engine.rbf`; its ``warp``
+deformers (any kernel, fitted on the identity) are :mod:`facelib.engine.deformers.rbf`; its ``warp``
 gives the same map (a test checks it), without the coefficients this module needs.
 """
 

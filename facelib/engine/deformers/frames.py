@@ -32,8 +32,8 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from facelib.engine.control_mesh import ControlMesh, control_mesh, triangle_frames
-from facelib.engine.registry import Deformer, FrameStep, RegionSetup
+from facelib.engine.deformers.base import Deformer, FrameStep, RegionSetup
+from facelib.engine.deformers.control_mesh import ControlMesh, control_mesh, triangle_frames
 
 __all__ = ["DEFORMERS", "FrameMap", "frame_map", "linearise"]
 

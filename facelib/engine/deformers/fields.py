@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from facelib.engine.registry import Deformer, RegionSetup
+from facelib.engine.deformers.base import Deformer, RegionSetup
 from facelib.errors import FacelibError, FaceModelError
 from facelib.mpeg4.tables import fap
 

@@ -23,9 +23,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.distance import cdist
 
+from facelib.engine.deformers.base import Deformer, RegionSetup
 from facelib.errors import FaceModelError
 
-__all__ = ["KERNELS", "interpolation_weights", "warp"]
+__all__ = ["KERNELS", "RBF", "interpolation_weights", "warp"]
 
 SCIPY_KERNELS = ("linear", "thin_plate_spline", "cubic", "quintic", "multiquadric",
                  "inverse_multiquadric", "inverse_quadratic", "gaussian")
@@ -149,3 +150,28 @@ def warp(sources: np.ndarray, targets: np.ndarray, points: np.ndarray, **options
     """
     w = interpolation_weights(sources, points, **options)  # type: ignore[arg-type]
     return w @ np.asarray(targets, dtype=np.float64)
+
+
+def _rbf(setup: RegionSetup) -> np.ndarray:
+    p = setup.params
+    pos = setup.vertices
+    sources = pos[np.concatenate([setup.controls, setup.anchors])]
+    kernel = str(p["kernel"])
+    degree = p["polynomial"]
+    if degree is None:
+        degree = -1 if kernel == "multiquadric_eck" else 1
+    try:
+        w = interpolation_weights(sources, pos[setup.members], kernel=kernel,
+                                  degree=int(degree), smoothing=float(p["smoothing"]),
+                                  epsilon=p["epsilon"])
+    except FaceModelError as exc:
+        raise setup.fail(exc.message) from exc
+    # anchors stay still: only the control columns carry motion
+    return w[:, : setup.controls.size]
+
+
+RBF = Deformer(
+    "rbf", _rbf,
+    {"kernel": "multiquadric_eck", "polynomial": None, "smoothing": 0.0, "epsilon": None},
+    "radial basis functions through controls and static anchors",
+    "second seed eq. 2.17-2.21; first seed eq. 4.8-4.10 (kernel multiquadric_eck)")

@@ -31,12 +31,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from facelib.engine import rigid
-from facelib.engine.eyelids import close_upper_lid
 from facelib.engine.face import OPTIONAL_PARTS, PART_NAMES, Face, Region, Riders
 from facelib.engine.fapu import compute_fapu
-from facelib.engine.headmesh import HeadMesh
+from facelib.engine.setup.eyelids import close_upper_lid
+from facelib.engine.setup.headmesh import HeadMesh
+from facelib.engine.setup.tps import ThinPlateSpline
 from facelib.engine.surface import Surface, SurfacePoints, closest_points, surface, vertex_normals
-from facelib.engine.tps import ThinPlateSpline
 from facelib.mpeg4.tables import FAPU_SCALE, fap_table
 
 __all__ = ["transfer_face"]
@@ -240,7 +240,7 @@ def _closed_lids(regions: tuple[Region, ...], *, verts: np.ndarray, skin: np.nda
                  points: Mapping[str, int], pivots: Mapping[str, np.ndarray],
                  eyes: Mapping[str, np.ndarray]) -> tuple[Region, ...]:
     """The upper eyelid regions refitted to close over the target's eye opening
-    (:func:`facelib.engine.eyelids.close_upper_lid`). verts: (V, 3) output positions;
+    (:func:`facelib.engine.setup.eyelids.close_upper_lid`). verts: (V, 3) output positions;
     skin: (F, 3) skin triangles; eyes: eye part name -> its vertex ids."""
     fapu = compute_fapu(verts, points)
     out = []

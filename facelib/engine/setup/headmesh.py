@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 
 from facelib.engine.mesh_files import ConfinedFiles, check_mesh_file
-from facelib.errors import FaceModelError, MissingExtraError
+from facelib.errors import FaceModelError
+from facelib.optional import require
 
 __all__ = ["AXES", "MESH_SUFFIXES", "HeadMesh", "axes_rotation", "head_mesh", "load_head_mesh"]
 
@@ -219,11 +220,7 @@ def _eye_sides(meshes: list[tuple[str, Any]], wanted: Mapping[str, str]) -> dict
 
 
 def _trimesh() -> Any:
-    try:
-        import trimesh
-    except ImportError as exc:
-        raise MissingExtraError("reading head meshes", "mesh", "trimesh") from exc
-    return trimesh
+    return require("trimesh")
 
 
 _PARSER_SLIPS = (IndexError, KeyError, AttributeError, TypeError, NameError, AssertionError,

@@ -11,9 +11,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.distance import cdist
 
+from facelib.engine.deformers.base import Deformer, RegionSetup
 from facelib.errors import FaceModelError
 
-__all__ = ["explicit_weights", "raised_cosine_weights", "rbf_weights"]
+__all__ = ["RAISED_COSINE", "WEIGHTS", "explicit_weights", "raised_cosine_weights", "rbf_weights"]
 
 RAISED_COSINE_W = 0.5
 """The constant w of eq. 4.7: with 0.5 the feature point itself moves by exactly its dFP."""
@@ -106,3 +107,37 @@ def rbf_weights(members: np.ndarray, controls: np.ndarray, anchors: np.ndarray) 
     except np.linalg.LinAlgError as exc:  # pragma: no cover - multiquadric H is invertible
         raise FaceModelError(f"RBF matrix is singular: {exc}") from exc
     return m[:, : controls.shape[0]]
+
+
+def _raised_cosine(setup: RegionSetup) -> np.ndarray:
+    pos = setup.vertices
+    members = pos[setup.members]
+    controls = pos[setup.controls]
+    radius = setup.params["radius"]
+    if radius == "edge":
+        edge = pos[_edge(setup.members, setup.triangles, len(pos))]
+        return raised_cosine_weights(members, controls, edge=edge)
+    if radius == "farthest":
+        return raised_cosine_weights(members, controls)
+    raise setup.fail(f"raised_cosine radius must be 'edge' or 'farthest', got {radius!r}")
+
+
+def _edge(members: np.ndarray, triangles: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Ids of the members that share a triangle with a vertex outside ``members``."""
+    inside = np.zeros(n_vertices, bool)
+    inside[members] = True
+    mixed = triangles[inside[triangles].any(1) & ~inside[triangles].all(1)]
+    return np.unique(mixed[inside[mixed]])
+
+
+def _explicit(setup: RegionSetup) -> np.ndarray:
+    return explicit_weights(setup.weights)
+
+
+RAISED_COSINE = Deformer(
+    "raised_cosine", _raised_cosine, {"radius": "edge"},
+    "raised-cosine falloff around each feature point, averaged over them",
+    "first seed eq. 4.7; radius 'farthest' is the thesis's d_max, 'edge' the nearest "
+    "region-edge vertex")
+WEIGHTS = Deformer("weights", _explicit, {}, "explicit per-vertex weights of one feature point",
+                   "face definition")
