@@ -41,6 +41,7 @@ class RenderJob:
     fps: float | None = None
     seed: int | None = None
     face: str | None = None
+    hair: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,6 +70,7 @@ def default_jobs() -> int:
 def render_job(job: RenderJob) -> BatchResult:
     """Render one :class:`RenderJob` in this process; errors become the result's ``error``."""
     from facelib.animation import run_fdl
+    from facelib.clip import face_for
     from facelib.mpeg4 import read_fap
     from facelib.rendering.frames import render
 
@@ -76,8 +78,8 @@ def render_job(job: RenderJob) -> BatchResult:
     try:
         source = (read_fap(job.source) if Path(job.source).suffix.lower() == ".fap"
                   else run_fdl(job.source, seed=job.seed))
-        out = render(source, face=job.face, out=job.output, width=job.width,
-                     height=job.height, fps=job.fps, progress=False)
+        out = render(source, face=face_for(source, job.face, job.hair), out=job.output,
+                     width=job.width, height=job.height, fps=job.fps, progress=False)
     except FacelibError as exc:
         return BatchResult(job.source, None, time.perf_counter() - started, str(exc))
     except Exception as exc:  # a bug or an environment failure: report it, keep going  # noqa: BLE001
@@ -100,6 +102,7 @@ def plan_jobs(
     sources: Sequence[str | os.PathLike[str]], out_dir: str | os.PathLike[str], *,
     suffix: str = ".mp4", width: int = 640, height: int = 480, fps: float | None = None,
     seed: int | None = None, face: str | os.PathLike[str] | None = None,
+    hair: str | None = None,
 ) -> list[RenderJob]:
     """One :class:`RenderJob` per source, writing ``out_dir/STEM{suffix}``; refuses two
     sources with the same stem (they would overwrite each other)."""
@@ -115,7 +118,7 @@ def plan_jobs(
                                  f"{stem}{suffix}: rename one or render them separately")
         seen[stem] = str(source)
         jobs.append(RenderJob(str(source), str(folder / f"{stem}{suffix}"), width, height,
-                              fps, seed, None if face is None else str(face)))
+                              fps, seed, None if face is None else str(face), hair))
     return jobs
 
 
@@ -130,6 +133,7 @@ def render_batch(
     fps: float | None = None,
     seed: int | None = None,
     face: str | os.PathLike[str] | None = None,
+    hair: str | None = None,
     progress: bool | ProgressCallback | None = None,
 ) -> tuple[BatchResult, ...]:
     """Render every source (``.fdl`` or ``.fap``) to ``out_dir/STEM{suffix}`` with ``jobs``
@@ -138,10 +142,11 @@ def render_batch(
     Returns one :class:`BatchResult` per source, in the order given. ``progress`` is called
     as ``progress(sources_done, n_sources)``. Workers are fresh (spawned) processes, so the
     caller's OpenGL state never leaks into them; Ctrl-C or SIGTERM stops them all, and
-    their atomic writers leave no partial files.
+    their atomic writers leave no partial files. ``face`` and ``hair`` as
+    :func:`facelib.clip.face_for` takes them (``hair``: every source's face wears it).
     """
     planned = plan_jobs(sources, out_dir, suffix=suffix, width=width, height=height,
-                        fps=fps, seed=seed, face=face)
+                        fps=fps, seed=seed, face=face, hair=hair)
     n_jobs = default_jobs() if jobs is None else check_count("jobs", jobs, low=1)
     n_jobs = min(n_jobs, max(len(planned), 1))
     output_folder(out_dir)

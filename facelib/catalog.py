@@ -2,7 +2,9 @@
 
 Expressions come from the library (descriptions in ``facelib/data/catalog/expressions.csv``),
 eye behaviours from ``facelib/data/gaze/behaviours.json``, visemes from the MPEG-4 table
-``facelib/data/mpeg4_visemes.csv`` (every alias a script may use is listed with its viseme).
+``facelib/data/mpeg4_visemes.csv`` (every alias a script may use is listed with its viseme),
+hair styles from the bundled head's hair mesh (descriptions in
+``facelib/data/head/hair_styles.json``).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from facelib.errors import DataError, FacelibError
 
 __all__ = ["KINDS", "Entry", "catalog"]
 
-KINDS = ("expressions", "visemes", "behaviours", "voices", "languages")
+KINDS = ("expressions", "visemes", "behaviours", "voices", "languages", "hair")
 
 EXPRESSION_GALLERY = "docs/images/expressions.png"
 
@@ -39,7 +41,7 @@ def catalog(kind: str, *, lang: str | None = None) -> tuple[Entry, ...]:
         raise FacelibError(f"unknown kind {kind!r}; choose one of {', '.join(KINDS)}")
     listers: dict[str, Callable[[], tuple[Entry, ...]]] = {
         "expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
-        "voices": _voices, "languages": _languages}
+        "voices": _voices, "languages": _languages, "hair": _hair}
     entries = listers[kind]()
     if lang and kind == "voices":
         wanted = lang.lower()
@@ -97,3 +99,12 @@ def _languages() -> tuple[Entry, ...]:
 
     return tuple(Entry(lang.lang, f"{lang.name} (espeak-ng voice {lang.voice}); e.g. "
                                   f"{lang.sentence!r}") for lang in languages().values())
+
+
+@cache
+def _hair() -> tuple[Entry, ...]:
+    from facelib.engine import hair_style_names
+
+    styles = data.json_data("head/hair_styles.json")["styles"]
+    return tuple(Entry(name, "bald: no hair" if name == "none" else str(
+        styles.get(name, {}).get("description", ""))) for name in hair_style_names())

@@ -28,10 +28,21 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from facelib.errors import ParameterError
+from facelib.checks import did_you_mean
+from facelib.errors import FdlError, ParameterError
 from facelib.mpeg4.stream import FapStream
 
-__all__ = ["CameraMove", "Clip", "Deformable", "Speech", "make_clip", "resolve_face"]
+__all__ = [
+    "CameraMove",
+    "Clip",
+    "Deformable",
+    "Speech",
+    "check_hair",
+    "face_for",
+    "make_clip",
+    "resolve_face",
+    "styled_face",
+]
 
 
 @runtime_checkable
@@ -155,6 +166,50 @@ def resolve_face(face: FaceArg) -> Deformable:
     return default_face() if face is None else face
 
 
+def styled_face(definition: str | os.PathLike[str] | None, hair: str | None) -> Deformable:
+    """The face definition JSON ``definition`` (None: the bundled head) loaded wearing the
+    hair style ``hair`` (``"none"``: bald; None: the definition's own). ParameterError
+    naming the definition's styles, with a did-you-mean, for a style it does not have."""
+    from facelib.engine import load_face
+
+    if hair is None:
+        return resolve_face(definition)
+    where = None if definition is None else Path(definition)
+    check_hair(where, hair)
+    return load_face(where, hair=hair)
+
+
+def check_hair(definition: str | os.PathLike[str] | None, hair: str, *,
+               path: str | Path | None = None, line: int | None = None) -> None:
+    """Check that ``hair`` is a style of the face definition ``definition`` (None: the
+    bundled head) without loading the face: ParameterError naming its styles, with a
+    did-you-mean, or FdlError at ``path``:``line`` when a storyboard file is given."""
+    from facelib.engine import hair_style_names
+
+    where = None if definition is None else Path(definition)
+    styles = hair_style_names(where)
+    if hair in styles:
+        return
+    name = "the bundled head" if where is None else where.name
+    message = (f"hair style {hair!r} is not one of {name}'s ({', '.join(styles)})"
+               f"{did_you_mean(hair, styles)}")
+    raise ParameterError(message) if path is None else FdlError(message, path=path, line=line)
+
+
+def face_for(source: object, definition: str | os.PathLike[str] | None,
+             hair: str | None) -> FaceArg:
+    """What an output of ``source`` is given as its face for a face definition
+    ``definition`` (None: none named) and a hair style ``hair``: ``definition`` itself when
+    ``hair`` is None (the storyboard's face and hair then apply as :func:`make_clip` says);
+    else that definition, or the face ``source``'s storyboard names, or the bundled head,
+    loaded wearing ``hair`` (:func:`styled_face`)."""
+    if hair is None:
+        return definition
+    if definition is None:
+        definition = getattr(getattr(source, "storyboard", None), "face", None)
+    return styled_face(definition, hair)
+
+
 def make_clip(
     source: Clip | FapStream | object,
     *,
@@ -162,6 +217,7 @@ def make_clip(
     audio: str | os.PathLike[str] | None = None,
     audio_offset: float | None = None,
     storyboard_face: bool = True,
+    storyboard_hair: bool = True,
 ) -> Clip:
     """The :class:`Clip` of ``source``: a Clip, a FapStream, or an animation (an object with
     a ``faps`` FapStream and optionally ``audio``, ``audio_offset``, ``speech_audio`` and a
@@ -169,12 +225,16 @@ def make_clip(
 
     face: the face to play on (a face-like object or a face definition JSON path, loaded);
         None keeps a Clip's face, else takes the face the storyboard names (unless
-        ``storyboard_face`` is False), else None: the bundled head.
+        ``storyboard_face`` is False), else None: the bundled head. Without ``face``, a
+        storyboard's ``hair`` style is worn by that face (or by the bundled head when
+        ``storyboard_face`` is False) unless ``storyboard_hair`` is False (FdlError naming
+        the storyboard's line for a style the face lacks); a given ``face`` keeps its own.
     audio, audio_offset: the audio rule of the module docstring; an explicit ``audio`` must
         be an existing file (ParameterError otherwise), as must the source's own.
     """
     clip = (source if isinstance(source, Clip)
-            else _from_source(source, storyboard_face=storyboard_face and face is None))
+            else _from_source(source, storyboard_face=storyboard_face and face is None,
+                              storyboard_hair=storyboard_hair and face is None))
     if face is not None:
         clip = replace(clip, face=resolve_face(face) if isinstance(face, (str, os.PathLike))
                        else face)
@@ -187,7 +247,21 @@ def make_clip(
     return clip
 
 
-def _from_source(source: object, *, storyboard_face: bool) -> Clip:
+def _storyboard_face(storyboard: object, *, use_face: bool,
+                     use_hair: bool) -> Deformable | None:
+    """The face a storyboard names (if ``use_face``) wearing its ``hair`` (if ``use_hair``),
+    or None for the bundled head as it is."""
+    named = getattr(storyboard, "face", None) if use_face else None
+    hair = getattr(storyboard, "hair", None) if use_hair else None
+    if hair is None:
+        return None if named is None else resolve_face(named)
+    lines = getattr(storyboard, "setting_lines", None) or {}
+    check_hair(named, hair, path=getattr(storyboard, "path", None) or "<storyboard>",
+               line=lines.get("hair"))
+    return styled_face(named, hair)
+
+
+def _from_source(source: object, *, storyboard_face: bool, storyboard_hair: bool) -> Clip:
     """A Clip of a FapStream or an animation (read by attribute name here, and only here)."""
     if isinstance(source, FapStream):
         return Clip(source)
@@ -196,7 +270,6 @@ def _from_source(source: object, *, storyboard_face: bool) -> Clip:
         raise ParameterError(f"an output needs a FapStream, a Clip or an animation with a "
                              f".faps FapStream, not {type(source).__name__}")
     storyboard = getattr(source, "storyboard", None)
-    named = getattr(storyboard, "face", None) if storyboard_face else None
     own = getattr(source, "audio", None)
     samples = getattr(source, "speech_audio", None)
     speech = (None if samples is None
@@ -205,7 +278,8 @@ def _from_source(source: object, *, storyboard_face: bool) -> Clip:
         CameraMove(str(cue.framing), int(cue.start_ms), int(cue.duration_ms),
                    getattr(cue, "origin", None))
         for cue in (getattr(storyboard, "camera", ()) or ()))
-    return Clip(stream, face=None if named is None else resolve_face(named),
+    return Clip(stream, face=_storyboard_face(storyboard, use_face=storyboard_face,
+                                              use_hair=storyboard_hair),
                 audio=None if own is None else Path(own), speech=speech,
                 audio_offset=float(getattr(source, "audio_offset", 0.0) or 0.0),
                 camera=camera)

@@ -160,6 +160,10 @@ class Storyboard:
         Mixes of expressions the storyboard itself defines are resolved at load time.
     output: where the storyboard asks the ``.fap`` to go, or None.
     face: the face definition JSON the storyboard is played on, or None (the default head).
+    hair: the hair style the face wears (``hair = "long"``; ``"none"``: bald), or None (the
+        face definition's own); checked when the face is loaded (:func:`facelib.clip.make_clip`).
+    setting_lines: the line of a setting the file sets, for errors found after loading
+        (``{"hair": 3}``: an unknown hair style is found when the face is loaded).
     language: the storyboard's language (``language = "pt"``), used by speech that names
         none; None means English.
     camera: the camera cues, in time order (the renderer re-frames at each).
@@ -177,6 +181,8 @@ class Storyboard:
     output: Path | None = None
     expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     face: Path | None = None
+    hair: str | None = None
+    setting_lines: Mapping[str, int] = field(default_factory=dict)
     language: str | None = None
     camera: tuple[CameraCue, ...] = ()
     moods: tuple[MoodCue, ...] = ()
@@ -185,6 +191,7 @@ class Storyboard:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
         object.__setattr__(self, "gaze_defs", _frozen_map(self.gaze_defs))
         object.__setattr__(self, "expression_mixes", _frozen_map(self.expression_mixes))
+        object.__setattr__(self, "setting_lines", _frozen_map(self.setting_lines))
 
     @property
     def cues_end_ms(self) -> int:

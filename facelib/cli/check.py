@@ -25,6 +25,11 @@ def _check(args: argparse.Namespace, console: Console) -> int:
     from facelib.fdl import describe, load
 
     storyboard = load(args.story, seed=args.seed)
+    if storyboard.hair is not None:  # render would refuse it when it loads the face
+        from facelib.clip import check_hair
+
+        check_hair(storyboard.face, storyboard.hair, path=args.story,
+                   line=storyboard.setting_lines.get("hair"))
     animation = animate(storyboard, seed=args.seed)  # what run rejects, check rejects
     print(describe(storyboard))
     target = default_output(args.story, storyboard.output, ".fap")

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from facelib.cli.console import EXIT_OK, Console, UsageError
-from facelib.cli.options import COMMON, chosen_face, read_source
+from facelib.cli.options import COMMON, add_hair, output_face, read_source
 from facelib.cli.outputs import check_suffix
 
 
@@ -30,6 +30,7 @@ def add(commands: Any) -> None:
                         help="also write a VRM 1.0 avatar of the head (expression presets aa ... "
                              "lookRight, humanoid, look-at; no animation)")
     export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    add_hair(export)
     export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
     export.add_argument("--seed", type=int)
     export.set_defaults(run=_export)
@@ -47,7 +48,11 @@ def _export(args: argparse.Namespace, console: Console) -> int:
     if args.output is not None:
         check_suffix(args.output, (".csv", ".json") if args.arkit else
                      (".glb", ".csv", ".json"), "export")
-    face = chosen_face(args.face)
+    face = output_face(args, None)  # exports ignore a storyboard's face, not its hair
+    if face is not None and not hasattr(face, "vertices"):
+        from facelib.engine import load_face
+
+        face = load_face(face)
     source = read_source(args.source, args.seed, console)
     if args.output is not None:
         suffix = Path(args.output).suffix.lower()

@@ -1,5 +1,5 @@
 """The options and inputs several commands share: ``-q``/``-v`` (:data:`COMMON`, the parent
-of every parser), ``--face`` and a SOURCE that is a storyboard or a ``.fap`` file."""
+of every parser), ``--face``, ``--hair`` and a SOURCE that is a storyboard or a ``.fap`` file."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from facelib.cli.console import Console
+from facelib.cli.console import Console, UsageError
 from facelib.mpeg4 import read_fap
 
 COMMON = argparse.ArgumentParser(add_help=False)
@@ -23,6 +23,27 @@ def face_path(face: str | None) -> Path | None:
         return None
     path = Path(face)
     return path / "face.json" if path.is_dir() else path
+
+
+def add_hair(command: argparse.ArgumentParser) -> None:
+    """``--hair STYLE``: the hair style the face wears."""
+    command.add_argument("--hair", metavar="STYLE",
+                         help="the hair style the face wears (the bundled head's: short, long, "
+                              "tied; none: bald; default: the storyboard's, else the face's "
+                              "own; `facelib list hair`)")
+
+
+def output_face(args: argparse.Namespace, source: Any) -> Any:
+    """What ``--face`` and ``--hair`` give an output of ``source``: the ``--face`` path or
+    None, or with ``--hair`` that face (else the storyboard's, else the bundled head) loaded
+    wearing the style; UsageError, with a did-you-mean, for a style the face lacks."""
+    from facelib.clip import face_for
+    from facelib.errors import ParameterError
+
+    try:
+        return face_for(source, face_path(args.face), args.hair)
+    except ParameterError as exc:
+        raise UsageError(f"--hair: {exc.message}") from None
 
 
 def chosen_face(face: str | None) -> Any:

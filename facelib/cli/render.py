@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from facelib.cli.console import EXIT_ERROR, EXIT_OK, Console, UsageError
-from facelib.cli.options import COMMON, face_path, read_source
+from facelib.cli.options import COMMON, add_hair, face_path, output_face, read_source
 from facelib.cli.outputs import RENDER_SUFFIXES, check_suffix, default_output
 from facelib.mpeg4 import FapStream, write_fap_complete
 
@@ -22,6 +22,7 @@ def _add_render_options(command: argparse.ArgumentParser, *, batch: bool) -> Non
     command.add_argument("-o", "--output", required=not batch, help=help_out)
     command.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
                          "folder (default: the storyboard's face, else the bundled head)")
+    add_hair(command)
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)
     command.add_argument("--fps", type=float, help="resample to this frame rate")
@@ -61,7 +62,7 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
         written_faps = write_fap_complete(stream, args.fap)
         console.status(f"wrote {' and '.join(map(str, written_faps))} ({stream.n_frames} "
                        f"frames, {stream.duration:.2f} s)")
-    written = render(source, face=face_path(args.face), out=out, width=args.width,
+    written = render(source, face=output_face(args, source), out=out, width=args.width,
                      framing=args.framing,
                      height=args.height, audio=args.audio, fps=args.fps,
                      progress=console.progress("rendering"))
@@ -104,7 +105,8 @@ def _render(args: argparse.Namespace, console: Console) -> int:
     results = render_batch(
         args.sources, args.output, jobs=args.jobs, suffix="." + args.format,
         width=args.width, height=args.height, fps=args.fps, seed=args.seed,
-        face=face_path(args.face), progress=console.progress("batch", unit="files"),
+        face=face_path(args.face), hair=args.hair,
+        progress=console.progress("batch", unit="files"),
     )
     for result in results:
         if result.ok:

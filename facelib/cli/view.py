@@ -6,7 +6,7 @@ import argparse
 from typing import Any
 
 from facelib.cli.console import EXIT_OK, Console
-from facelib.cli.options import COMMON, face_path, read_source
+from facelib.cli.options import COMMON, add_hair, output_face, read_source
 
 
 def add(commands: Any) -> None:
@@ -16,6 +16,7 @@ def add(commands: Any) -> None:
     view.add_argument("source", help="STORY.fdl or FILE.fap")
     view.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
                       "folder (default: the storyboard's face, else the bundled head)")
+    add_hair(view)
     view.add_argument("--loop", action="store_true", help="replay until the window is closed")
     view.add_argument("--mute", action="store_true", help="do not play the speech audio")
     view.add_argument("--seed", type=int)
@@ -25,7 +26,7 @@ def add(commands: Any) -> None:
 def _view(args: argparse.Namespace, console: Console) -> int:
     from facelib.rendering.viewer import view
 
-    view(read_source(args.source, args.seed, console), face=face_path(args.face),
-         loop=args.loop, sound=not args.mute)
+    source = read_source(args.source, args.seed, console)
+    view(source, face=output_face(args, source), loop=args.loop, sound=not args.mute)
     return EXIT_OK
 

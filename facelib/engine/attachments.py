@@ -18,10 +18,11 @@ from typing import Any
 
 import numpy as np
 
+from facelib.checks import did_you_mean
 from facelib.engine.meshfile import mesh_path, read_npz
 from facelib.errors import FaceModelError
 
-__all__ = ["Attachment", "attach", "hair_styles", "read_attachments"]
+__all__ = ["Attachment", "attach", "definition_hair_styles", "hair_styles", "read_attachments"]
 
 
 @dataclass(frozen=True)
@@ -92,8 +93,9 @@ def _hair(where: Path, style: str, base: int) -> Attachment:
     data = read_npz(where)
     styles = tuple(str(s) for s in data.get("styles", ()))
     if style not in styles:
-        raise FaceModelError(f"hair style {style!r} is not in {where.name}; styles: "
-                             f"{', '.join(styles)}", path=where)
+        raise FaceModelError(f"hair style {style!r} is not in {where.name} (styles: "
+                             f"{', '.join((*styles, 'none'))}){did_you_mean(style, styles)}",
+                             path=where)
     try:
         v = data[f"{style}_vertices"].astype(np.float64)
         t = data[f"{style}_triangles"].astype(np.int64) + base
@@ -114,6 +116,15 @@ def _entry(doc: dict[str, Any], key: str, where: Path) -> dict[str, Any] | None:
     if not isinstance(item, dict) or not isinstance(item.get("mesh"), str):
         raise FaceModelError(f"{key!r} must be an object with a 'mesh' file name", path=where)
     return item
+
+
+def definition_hair_styles(definition: Path, doc: dict[str, Any]) -> tuple[str, ...]:
+    """The hair styles a definition ``doc`` (read from ``definition``) may wear: its hair
+    mesh's styles, then ``"none"`` (bald; the only one of a definition without hair)."""
+    item = _entry(doc, "hair", definition)
+    if item is None:
+        return ("none",)
+    return (*hair_styles(mesh_path(definition, item["mesh"])), "none")
 
 
 def read_attachments(definition: Path, doc: dict[str, Any], head: np.ndarray, *,

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from facelib import data
-from facelib.engine.attachments import attach, read_attachments
+from facelib.engine.attachments import attach, definition_hair_styles, read_attachments
 from facelib.engine.deformers import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.face import (
     ATTACHED_PARTS,
@@ -31,7 +31,7 @@ from facelib.engine.riders import Riders, no_riders
 from facelib.errors import FacelibError, FaceModelError, ParameterError
 from facelib.mpeg4.tables import fap, fap_table, feature_point_table
 
-__all__ = ["FORMAT", "VERSION", "load_face", "required_feature_points"]
+__all__ = ["FORMAT", "VERSION", "hair_style_names", "load_face", "required_feature_points"]
 
 FORMAT = "facelib-face"
 VERSION = 1
@@ -87,6 +87,22 @@ def load_face(
     ParameterError: an override key that names no region or group.
     """
     path = _default_path() if path is None else Path(path)
+    return _Reader(path, _read_definition(path), dict(deformers or {}), hair).face()
+
+
+def hair_style_names(path: str | Path | None = None) -> tuple[str, ...]:
+    """The hair styles the face definition at ``path`` (None: the default head) may wear,
+    as ``load_face(path, hair=...)`` takes them: its hair mesh's styles, then ``"none"``.
+    FaceModelError for an unreadable definition or hair mesh."""
+    path = _default_path() if path is None else Path(path)
+    doc = _read_definition(path)
+    if not isinstance(doc, dict):
+        raise FaceModelError("a face definition is a JSON object", path=path)
+    return definition_hair_styles(path, doc)
+
+
+def _read_definition(path: Path) -> Any:
+    """The JSON document of the face definition at ``path`` (size, UTF-8 and syntax checked)."""
     try:
         with path.open("rb") as file:
             raw = file.read(MAX_DEFINITION_BYTES + 1)
@@ -106,7 +122,7 @@ def load_face(
     except RecursionError:
         raise FaceModelError("the face definition's JSON is nested too deeply (a face "
                              "definition is a few levels deep)", path=path) from None
-    return _Reader(path, doc, dict(deformers or {}), hair).face()
+    return doc
 
 
 def _override(value: Override, key: str) -> tuple[str, Deformer | None, dict[str, Any]]:

@@ -23,7 +23,8 @@ def export_clip(source: Source, *, face: Face | None = None,
     """The Clip an export plays: ``source`` with ``face`` and ``audio`` as
     :func:`facelib.clip.make_clip` takes them (the audio rule of :mod:`facelib.clip`), except
     that a face the storyboard names is not used: exports play on the bundled head unless
-    given a face (its ARKit targets and morph targets belong to it). ParameterError for a
+    given a face (its ARKit targets and morph targets belong to it), wearing the
+    storyboard's ``hair`` style if it names one. ParameterError for a
     stream without frames or an audio file that does not exist."""
     clip = make_clip(source, face=face, audio=audio, storyboard_face=False)
     if clip.n_frames == 0:

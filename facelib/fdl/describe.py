@@ -21,7 +21,8 @@ def describe(sb: Storyboard) -> str:
     out = [
         f"storyboard: {sb.path or '<string>'}",
         f"fps: {sb.fps:g}  seed: {sb.seed}  output: {sb.output or 'none'}"
-        + (f"  face: {sb.face}" if sb.face is not None else ""),
+        + (f"  face: {sb.face}" if sb.face is not None else "")
+        + (f"  hair: {sb.hair}" if sb.hair is not None else ""),
     ]
     s = sb.speech
     if s is not None:

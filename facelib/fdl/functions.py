@@ -94,6 +94,8 @@ SETTINGS: Mapping[str, str] = MappingProxyType({
     "output": 'the .fap file to write, relative to the storyboard, or "none"',
     "face": "the face definition JSON to play on, relative to the storyboard "
             "(e.g. made by facelib face setup; default: the bundled head)",
+    "hair": 'the hair style the face wears ("short", "long", "tied", "none": bald; '
+            "default: the face definition's)",
     "language": 'language of speech that names none ("pt", "de", ...; default English)',
 })  # fmt: skip
 """Globals that set storyboard options, with what each means."""

@@ -4,8 +4,9 @@ One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
 ``fps`` (default 25), ``seed`` (default 0), ``output``, ``face`` (a face definition JSON,
-e.g. one made by ``facelib face setup``) and ``language`` (default English; the language of
-speech that names none) set the storyboard options; every name is declared in
+e.g. one made by ``facelib face setup``), ``hair`` (a hair style of that face; checked
+against the face's styles when the face is loaded) and ``language`` (default English; the
+language of speech that names none) set the storyboard options; every name is declared in
 :mod:`facelib.fdl.functions`. Each syntax converts to cues in its own module
 (:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs the
 script, reads the settings and merges the two.
@@ -174,6 +175,18 @@ def _fps(chunk: ChunkResult, text: str, name: str) -> float:
     return float(fps)
 
 
+def _hair(chunk: ChunkResult, text: str, name: str) -> tuple[str | None, dict[str, int]]:
+    """The ``hair`` global (a style name, or None) and ``{"hair": line}`` when it is set."""
+    hair = _global(chunk, "hair")
+    line = _line(text, "hair")
+    if hair is None:
+        return None, {}
+    if not (isinstance(hair, str) and hair.strip()):
+        raise FdlError(f'hair must be a hair style name like "long" (or "none"); got {hair!r}',
+                       path=name, line=line)
+    return hair.strip(), {} if line is None else {"hair": line}
+
+
 def _build(
     chunk: ChunkResult,
     text: str,
@@ -206,6 +219,7 @@ def _build(
     face_value = _global(chunk, "face")
     face = (None if face_value is None else resolve_inside(
         base_dir, face_value, what="face", path=name, line=_line(text, "face")))
+    hair, lines = _hair(chunk, text, name)
     return Storyboard(
         path=file,
         fps=fps,
@@ -220,6 +234,8 @@ def _build(
         output=output,
         expression_mixes=parts.expression_mixes,
         face=face,
+        hair=hair,
+        setting_lines=lines,
         camera=camera_cues(parts.camera, ctx),
         moods=mood_cues(parts.moods, ctx),
     )

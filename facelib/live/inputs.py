@@ -95,7 +95,8 @@ def cues_from_fdl(snippet: str) -> Cues:
     board = loads(snippet, name="<cue>", sandbox=Sandbox(max_memory=_SNIPPET_MEMORY,
                                                          max_instructions=_SNIPPET_STEPS))
     if (board.speech is not None or board.expression_defs or board.gaze_defs
-            or board.expression_mixes or board.output is not None or board.face is not None):
+            or board.expression_mixes or board.output is not None or board.face is not None
+            or board.hair is not None):
         raise FdlError("a cue snippet may only show, look and move the camera "
                        "(speech goes in a text message)", path="<cue>", line=1)
     return Cues(board.expressions, board.gaze, board.camera)

@@ -35,7 +35,7 @@ _CHUNK = 32  # frames deformed at once: bounds memory to 32 x V x 3 floats
 def stream_of(source: FapStream | HasFaps | Clip) -> tuple[FapStream, Path | None, float]:
     """``(stream, audio path or None, audio offset in seconds)`` of a render source (see
     :func:`facelib.clip.make_clip`; kept for callers of earlier versions)."""
-    clip = make_clip(source, storyboard_face=False)
+    clip = make_clip(source, storyboard_face=False, storyboard_hair=False)
     return clip.stream, clip.audio, clip.audio_offset
 
 

@@ -85,3 +85,45 @@ def test_playing_changes_the_frames(shots):
     first, second = _png(out / "play_0.png"), _png(out / "play_1.png")
     assert summary["play"][1] > summary["play"][0]
     assert np.abs(first.astype(int) - second.astype(int)).max() > 50
+
+
+def test_the_page_carries_the_chosen_hair_and_the_bust(tmp_path):
+    """``facelib export --html DIR --hair long``: the browser shows the long hair and the
+    bust (framed on the bust) with the silhouette of facelib's render of that face."""
+    if CHROMIUM is None or not (WEB_DIR / "node_modules" / "puppeteer-core").exists():
+        pytest.skip("needs chromium and the npm packages (make setup)")
+    from facelib.cli import main
+    from facelib.engine import load_face
+    from facelib.mpeg4 import write_fap_complete
+    from facelib.rendering.scene import FaceRenderer, framing_points
+
+    stream = busy_stream(50)
+    write_fap_complete(stream, tmp_path / "busy.fap")
+    assert main(["export", str(tmp_path / "busy.fap"), "--html", str(tmp_path / "page"),
+                 "--hair", "long"]) == 0
+    faces = {style: load_face(hair=style) for style in ("long", "none")}
+    bust = framing_points(faces["long"], "bust")  # both framed as the long-haired face
+    own = {}
+    for style, face in faces.items():
+        with FaceRenderer(face, width=640, height=480, background=GREEN,
+                          framing=bust) as renderer:
+            camera = renderer.scene.main_camera_node.camera
+            job = {"bg": "00ff00", "chromium": CHROMIUM, "play_ms": 100,
+                   "camera": [renderer.camera_pose.tolist(), camera.yfov, camera.znear,
+                              camera.zfar], "times": [0.0]}
+            own[style] = _silhouette(renderer.frame(face.deform_frame(stream.values[0])))
+    (tmp_path / "job.json").write_text(json.dumps(job))
+    (tmp_path / "out").mkdir()
+    run = subprocess.run(["node", str(WEB_DIR / "tools" / "shoot.mjs"), str(tmp_path / "page"),
+                          str(tmp_path / "out"), str(tmp_path / "job.json")],
+                         capture_output=True, text=True, timeout=180, check=False)
+    assert run.returncode == 0, run.stderr[-2000:]
+    browser = _silhouette(_png(tmp_path / "out" / "seek_0.png"))
+    assert browser.shape == own["long"].shape
+    overlap = (browser & own["long"]).sum() / (browser | own["long"]).sum()
+    assert overlap >= 0.95, overlap
+    bald = (browser & own["none"]).sum() / (browser | own["none"]).sum()
+    assert bald < overlap - 0.05, (bald, overlap)  # the hair is in the page
+    # the bust's shoulders fill the bottom rows as wide as in facelib's render
+    assert browser[-20:].mean() > 0.3
+    assert abs(browser[-20:].mean() - own["long"][-20:].mean()) < 0.03
