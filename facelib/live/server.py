@@ -22,7 +22,6 @@ import asyncio
 import base64
 import binascii
 import hmac
-import ipaddress
 import json
 import logging
 from collections.abc import Awaitable, Callable
@@ -31,7 +30,7 @@ from typing import Any
 
 from facelib.errors import FacelibError, ParameterError
 from facelib.live.session import OUTPUT_RATE, Output, Session
-from facelib.live.udp import parse_target
+from facelib.live.udp import is_loopback, parse_target
 from facelib.optional import require
 
 __all__ = ["HARD_MESSAGE_BYTES", "MAX_MESSAGE_BYTES", "ServerOptions", "frame_message",
@@ -65,19 +64,10 @@ class ServerOptions:
     vmc: str | None = None
 
     def __post_init__(self) -> None:
-        if not _is_loopback(self.host) and not self.token:
+        if not is_loopback(self.host) and not self.token:
             raise ParameterError(f"serving on {self.host!r} (not loopback) needs a token")
         if not 0 <= self.port <= 65535:
             raise ParameterError(f"port must be 0-65535, got {self.port!r}")
-
-
-def _is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
 
 
 def _websockets() -> Any:
