@@ -20,6 +20,7 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from contact_sheet import label, sheet
 
 from facelib.engine import Face, default_face
 from facelib.expressions import default_library
@@ -31,19 +32,6 @@ COLUMNS = 6
 CELL = (220, 264)  # width, height in pixels
 
 
-def _label(image: np.ndarray, text: str) -> np.ndarray:
-    from PIL import Image, ImageDraw
-
-    picture = Image.fromarray(image)
-    ImageDraw.Draw(picture).text((8, 6), text, fill=(240, 240, 240))
-    return np.asarray(picture)
-
-
-def _sheet(images: list[np.ndarray], columns: int) -> np.ndarray:
-    blank = np.zeros_like(images[0])
-    rows = [images[i : i + columns] for i in range(0, len(images), columns)]
-    rows[-1] = rows[-1] + [blank] * (columns - len(rows[-1]))
-    return np.concatenate([np.concatenate(row, 1) for row in rows], 0)
 
 
 def heads(names: tuple[str, ...]) -> dict[str, Face]:
@@ -68,7 +56,7 @@ def pose(name: str, intensity: float) -> np.ndarray:
     return (expression.share(intensity) * expression.values).astype(np.float32)
 
 
-def contact_sheet(face: Face, names: list[str], title: str) -> np.ndarray:
+def contactsheet(face: Face, names: list[str], title: str) -> np.ndarray:
     """Pairs of rows: each expression at 0.6 above the same at 1.0."""
     from facelib.rendering.scene import FaceRenderer
 
@@ -77,13 +65,13 @@ def contact_sheet(face: Face, names: list[str], title: str) -> np.ndarray:
         for start in range(0, len(names), COLUMNS):
             chunk = names[start : start + COLUMNS]
             for intensity in (0.6, 1.0):
-                row = [_label(renderer.frame(face.deform_frame(pose(n, intensity))),
+                row = [label(renderer.frame(face.deform_frame(pose(n, intensity))),
                               f"{title}: {n} {intensity:g}") for n in chunk]
                 cells += row + [np.zeros_like(row[0])] * (COLUMNS - len(row))
-    return _sheet(cells, COLUMNS)
+    return sheet(cells, COLUMNS)
 
 
-def review_sheet(face: Face, names: list[str], folder: Path) -> None:
+def reviewsheet(face: Face, names: list[str], folder: Path) -> None:
     """The unlabelled shuffled sheet at 0.6 and its key."""
     from facelib.rendering.scene import FaceRenderer
     from facelib.rendering.video import save_png
@@ -91,10 +79,10 @@ def review_sheet(face: Face, names: list[str], folder: Path) -> None:
     order = list(names)
     np.random.default_rng(REVIEW_SEED).shuffle(order)
     with FaceRenderer(face, width=300, height=360) as renderer:
-        pictures = [_label(renderer.frame(face.deform_frame(pose(n, 0.6))), str(i + 1))
+        pictures = [label(renderer.frame(face.deform_frame(pose(n, 0.6))), str(i + 1))
                     for i, n in enumerate(order)]
     folder.mkdir(parents=True, exist_ok=True)
-    save_png(_sheet(pictures, 4), folder / "expressions_review.png")
+    save_png(sheet(pictures, 4), folder / "expressions_review.png")
     key = "".join(f"{i + 1} {n}\n" for i, n in enumerate(order))
     (folder / "expressions_review_key.txt").write_text(
         f"# answer key of expressions_review.png (intensity 0.6, default head, seed "
@@ -115,10 +103,10 @@ def main() -> None:
         names = ["neutral", *args.only.split(",")]
     out = Path(args.folder)
     for title, face in heads(tuple(args.heads.split(","))).items():
-        save_png(contact_sheet(face, names, title), out / f"expressions_{title}.png")
+        save_png(contactsheet(face, names, title), out / f"expressions_{title}.png")
         print(f"wrote {out / f'expressions_{title}.png'}")
     if args.review:
-        review_sheet(default_face(), ["neutral", *default_library().names], args.review)
+        reviewsheet(default_face(), ["neutral", *default_library().names], args.review)
         print(f"wrote {args.review / 'expressions_review.png'} and its key")
 
 

@@ -21,6 +21,7 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+from contact_sheet import label, sheet
 
 from facelib.engine import load_face
 from facelib.expressions import default_library
@@ -32,19 +33,6 @@ HEAT_MAX_MM = 15.0
 REVIEW_SEED = 14
 
 
-def _label(image: np.ndarray, text: str) -> np.ndarray:
-    from PIL import Image, ImageDraw
-
-    picture = Image.fromarray(image)
-    ImageDraw.Draw(picture).text((8, 6), text, fill=(235, 235, 235))
-    return np.asarray(picture)
-
-
-def _sheet(images: list[np.ndarray], columns: int) -> np.ndarray:
-    blank = np.zeros_like(images[0])
-    rows = [images[i : i + columns] for i in range(0, len(images), columns)]
-    rows[-1] = rows[-1] + [blank] * (columns - len(rows[-1]))
-    return np.concatenate([np.concatenate(row, 1) for row in rows], 0)
 
 
 def _heat(mm: np.ndarray) -> np.ndarray:
@@ -68,19 +56,19 @@ def heatmaps(face, out: Path) -> None:
             colours[:n_skin] = _heat(1000 * np.linalg.norm(disp, axis=1))
             painted = dataclasses.replace(face, vertex_colors=colours)
             with FaceRenderer(painted, width=260, height=300) as renderer:
-                rows[row].append(_label(renderer.frame(face.vertices), f"{name}: {what}"))
-    save_png(_sheet(rows[0] + rows[1], 3), out / "expression_heatmaps.png")
+                rows[row].append(label(renderer.frame(face.vertices), f"{name}: {what}"))
+    save_png(sheet(rows[0] + rows[1], 3), out / "expression_heatmaps.png")
 
 
-def review_sheet(face, folder: Path) -> None:
+def reviewsheet(face, folder: Path) -> None:
     order = list(UNIVERSAL)
     np.random.default_rng(REVIEW_SEED).shuffle(order)
     lib = default_library()
     with FaceRenderer(face, width=300, height=360) as renderer:
-        pictures = [_label(renderer.frame(face.deform_frame(lib.get(n).values)), str(i + 1))
+        pictures = [label(renderer.frame(face.deform_frame(lib.get(n).values)), str(i + 1))
                     for i, n in enumerate(order)]
     folder.mkdir(parents=True, exist_ok=True)
-    save_png(_sheet(pictures, 3), folder / "expressions_unlabelled.png")
+    save_png(sheet(pictures, 3), folder / "expressions_unlabelled.png")
     key = "".join(f"{i + 1} {n}\n" for i, n in enumerate(order))
     (folder / "expressions_unlabelled_order.txt").write_text(
         f"# answer key of expressions_unlabelled.png (seed {REVIEW_SEED}); do not show the "
@@ -97,11 +85,11 @@ def main() -> None:
     poses = {"neutral": np.zeros(84, np.float32)}
     poses |= {name: e.values for name, e in default_library().expressions.items()}
     with FaceRenderer(face, width=300, height=360) as renderer:
-        pictures = [_label(renderer.frame(face.deform_frame(v)), k) for k, v in poses.items()]
-        save_png(_sheet(pictures, 4), out / "expressions.png")
+        pictures = [label(renderer.frame(face.deform_frame(v)), k) for k, v in poses.items()]
+        save_png(sheet(pictures, 4), out / "expressions.png")
     heatmaps(face, out)
     if args.review:
-        review_sheet(face, args.review)
+        reviewsheet(face, args.review)
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from contact_sheet import label
 
 from facelib.animation import run_fdl
 from facelib.engine import default_face
@@ -26,13 +27,6 @@ ROOT = Path(__file__).resolve().parent.parent
 HEADS = ROOT / "examples" / "heads"
 MOMENTS = (0.6, 1.6, 3.2, 4.4, 5.6)  # seconds into the demo
 
-
-def _label(image: np.ndarray, text: str) -> np.ndarray:
-    from PIL import Image, ImageDraw
-
-    picture = Image.fromarray(image)
-    ImageDraw.Draw(picture).text((8, 6), text, fill=(235, 235, 235))
-    return np.asarray(picture)
 
 
 def _dots(image: np.ndarray, pixels: np.ndarray, colour: tuple[int, int, int]) -> np.ndarray:
@@ -60,7 +54,7 @@ def main(folder: str) -> None:
     rows, marks = [], []
     for name, (face, result) in heads.items():
         with FaceRenderer(face, width=260, height=300) as renderer:
-            row = [_label(renderer.frame(face.deform_frame(stream.values[k])),
+            row = [label(renderer.frame(face.deform_frame(stream.values[k])),
                           f"{name}  {k / stream.fps:.1f} s") for k in frames]
             rows.append(np.concatenate(row, axis=1))
             if result is not None:
@@ -70,7 +64,7 @@ def main(folder: str) -> None:
                 every = face.vertices[list(face.feature_points.values())]
                 image = _dots(image, renderer.project(every), (230, 60, 60))
                 image = _dots(image, renderer.project(given), (60, 220, 90))
-                marks.append(_label(image, f"{name}: {len(result.landmarks)} landmarks"))
+                marks.append(label(image, f"{name}: {len(result.landmarks)} landmarks"))
     save_png(np.concatenate(rows, axis=0), out / "own_heads.png")
     save_png(np.concatenate(marks, axis=1), out / "own_heads_landmarks.png")
     print(f"wrote {out / 'own_heads.png'} and {out / 'own_heads_landmarks.png'}")
