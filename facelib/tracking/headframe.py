@@ -24,8 +24,7 @@ from facelib.tracking.pose import HeadPose, fit_pose, refine_pose_2d, unpose, un
 from facelib.tracking.userfapu import complete_points, user_fapu
 
 __all__ = ["HeadFrame", "Neutral", "face_found", "face_frame", "fill_gaps", "frame_spans",
-           "head_frame", "neutral_face", "neutral_frames", "neutral_span", "remove_pose",
-           "to_head_frame"]
+           "head_frame", "neutral_face", "neutral_frames", "neutral_span", "to_head_frame"]
 
 
 @dataclass(frozen=True)
@@ -184,7 +183,7 @@ def _levelled(pose: HeadPose, level: np.ndarray) -> HeadPose:
     return HeadPose(pose.scale, level @ pose.rotation @ level.T, pose.translation @ level.T)
 
 
-def remove_pose(points: np.ndarray, layout: LandmarkLayout, image_rest: np.ndarray
+def _remove_pose(points: np.ndarray, layout: LandmarkLayout, image_rest: np.ndarray
                  ) -> tuple[np.ndarray, HeadPose | None]:
     """All landmarks ``(n, K, D)`` (face frame) in the neutral head's frame, and the fit to
     the neutral ``image_rest`` ``(K, D)``."""
@@ -215,7 +214,7 @@ def neutral_face(landmarks: np.ndarray, *, layout: LandmarkLayout, span: slice,
     points = face_frame(landmarks[frames])
     image_rest = points.mean(axis=0)
     level = _levelling(image_rest, layout)
-    rest = remove_pose(points, layout, image_rest)[0].mean(axis=0) @ level.T
+    rest = _remove_pose(points, layout, image_rest)[0].mean(axis=0) @ level.T
     rest_points = layout.feature_point_positions(rest[None])[0]
     units = user_fapu(dict(zip(layout.feature_points, rest_points, strict=True)), fapu)
     return Neutral(image_rest, rest, rest_points, units, level)
@@ -225,7 +224,7 @@ def to_head_frame(landmarks: np.ndarray, neutral: Neutral, *, layout: LandmarkLa
                   ) -> HeadFrame:
     """``(n, K, D)`` image-coordinate landmarks without gaps in the head frame of
     ``neutral`` (any frames of the track it was taken from, e.g. a chunk of a long one)."""
-    local, pose = remove_pose(face_frame(landmarks), layout, neutral.image_rest)
+    local, pose = _remove_pose(face_frame(landmarks), layout, neutral.image_rest)
     local = local @ neutral.level.T
     return HeadFrame(local, neutral.rest, layout.feature_point_positions(local),
                      neutral.rest_points, neutral.fapu,
