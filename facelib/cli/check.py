@@ -22,13 +22,13 @@ def add(commands: Any) -> None:
 
 def _check(args: argparse.Namespace, console: Console) -> int:
     from facelib.animation import animate
+    from facelib.clip import check_hair, storyboard_definition
     from facelib.fdl import describe, load
 
     storyboard = load(args.story, seed=args.seed)
+    definition = storyboard_definition(storyboard)  # an unknown character, at its line
     if storyboard.hair is not None:  # render would refuse it when it loads the face
-        from facelib.clip import check_hair
-
-        check_hair(storyboard.face, storyboard.hair, path=args.story,
+        check_hair(definition, storyboard.hair, path=args.story,
                    line=storyboard.setting_lines.get("hair"))
     animation = animate(storyboard, seed=args.seed)  # what run rejects, check rejects
     print(describe(storyboard))

@@ -10,7 +10,14 @@ from pathlib import Path
 from typing import Any
 
 from facelib.cli.console import EXIT_ERROR, EXIT_OK, Console, UsageError
-from facelib.cli.options import COMMON, add_hair, face_path, output_face, read_source
+from facelib.cli.options import (
+    COMMON,
+    FACE_HELP,
+    add_hair,
+    face_path,
+    output_face,
+    read_source,
+)
 from facelib.cli.outputs import RENDER_SUFFIXES, check_suffix, default_output
 from facelib.mpeg4 import FapStream, write_fap_complete
 
@@ -20,8 +27,8 @@ def _add_render_options(command: argparse.ArgumentParser, *, batch: bool) -> Non
                 + ("; with several sources or -j, the folder for STEM.mp4 files" if batch
                    else ""))
     command.add_argument("-o", "--output", required=not batch, help=help_out)
-    command.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
-                         "folder (default: the storyboard's face, else the bundled head)")
+    command.add_argument("--face", help=f"{FACE_HELP} (default: the storyboard's face, else "
+                         "the bundled head)")
     add_hair(command)
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)

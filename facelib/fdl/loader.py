@@ -4,9 +4,10 @@ One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
 ``fps`` (default 25), ``seed`` (default 0), ``output``, ``face`` (a face definition JSON,
-e.g. one made by ``facelib face setup``), ``hair`` (a hair style of that face; checked
-against the face's styles when the face is loaded) and ``language`` (default English; the
-language of speech that names none) set the storyboard options; every name is declared in
+e.g. one made by ``facelib face setup``, or a bundled character's name: ``face = "ben"``),
+``hair`` (a hair style of that face; checked against the face's styles when the face is
+loaded) and ``language`` (default English; the language of speech that names none) set the
+storyboard options; every name is declared in
 :mod:`facelib.fdl.functions`. Each syntax converts to cues in its own module
 (:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs the
 script, reads the settings and merges the two.
@@ -20,7 +21,7 @@ import warnings
 from pathlib import Path
 from typing import TypeVar
 
-from facelib.checks import did_you_mean
+from facelib.checks import did_you_mean, is_bare_name
 from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard
 from facelib.errors import FdlError, FdlWarning, ParameterError
 from facelib.fdl import modern_cues, thesis_cues
@@ -175,6 +176,21 @@ def _fps(chunk: ChunkResult, text: str, name: str) -> float:
     return float(fps)
 
 
+def _face(chunk: ChunkResult, text: str, name: str, base_dir: Path | None
+          ) -> tuple[Path | str | None, int | None]:
+    """The ``face`` global and its line: a face definition file inside the storyboard's
+    folder, or a bundled character's name (a bare word naming no file there, kept as the
+    string; checked when the face is loaded), or None."""
+    value = _global(chunk, "face")
+    if value is None:
+        return None, None
+    line = _line(text, "face")
+    if (isinstance(value, str) and is_bare_name(value)
+            and (base_dir is None or not (base_dir / value).exists())):
+        return value, line
+    return resolve_inside(base_dir, value, what="face", path=name, line=line), line
+
+
 def _hair(chunk: ChunkResult, text: str, name: str) -> tuple[str | None, dict[str, int]]:
     """The ``hair`` global (a style name, or None) and ``{"hair": line}`` when it is set."""
     hair = _global(chunk, "hair")
@@ -216,10 +232,9 @@ def _build(
                        path=name, line=_line(text, "language"))
     if output is not None:
         _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
-    face_value = _global(chunk, "face")
-    face = (None if face_value is None else resolve_inside(
-        base_dir, face_value, what="face", path=name, line=_line(text, "face")))
+    face, face_line = _face(chunk, text, name, base_dir)
     hair, lines = _hair(chunk, text, name)
+    lines = {**lines, **({} if face_line is None else {"face": face_line})}
     return Storyboard(
         path=file,
         fps=fps,
