@@ -70,7 +70,11 @@ AGES = {"baby": 0.0, "child": 1 / 3, "young": 2 / 3, "old": 1.0}  # anny's ancho
 LEVELS = {"min": 0.0, "average": 0.5, "max": 1.0}
 RACES = ("african", "asian", "caucasian")
 MOUTH_TOLERANCE = 30  # uint8 distance from the cavity's colour within which it is kept
-IRIS_POLAR = (0.175, 0.48)  # radians from the eye's pole: the iris rings of the eye sphere
+IRIS_POLAR = (0.175, 0.48)
+# heights (m) the last two bust rings reach at least (the default's: -0.36, -0.44): the
+# bust framing frames the hair too, and long hair reaches the shoulders, so the frame goes
+# lower than the default bust's cut edge
+BUST_END = (-0.46, -0.62)  # radians from the eye's pole: the iris rings of the eye sphere
 
 
 # ------------------------------------------------------------------------------ anny's blend
@@ -234,8 +238,10 @@ def recolour(colours: np.ndarray, verts: np.ndarray, doc: dict, spec: dict) -> n
     lo, hi = doc["parts"]["skin"]
     fp = doc["feature_points"]
     ratio = np.asarray(spec["skin_rgb"]) / np.asarray(head_build.SKIN)
-    cavity = np.linalg.norm(colours[lo:hi].astype(float) - np.asarray(head_build.MOUTH) * 255,
-                            axis=1) < MOUTH_TOLERANCE
+    lip = verts[fp["8.1"]]  # the cavity: its colour, behind the lips (brows are as dark)
+    cavity = ((np.linalg.norm(colours[lo:hi].astype(float)
+                              - np.asarray(head_build.MOUTH) * 255, axis=1) < MOUTH_TOLERANCE)
+              & (verts[lo:hi, 2] < lip[2] - 0.004) & (np.abs(verts[lo:hi, 1] - lip[1]) < 0.04))
     alpha = np.zeros((hi - lo, 3))
     head_build.paint_brows(verts.astype(np.float64), alpha, fp, hi - lo)
     alpha = alpha[:, 0] / head_build.BROW[0]  # each brow vertex's share of the brow colour
@@ -280,8 +286,8 @@ def rings_for(s: float, *, old: np.ndarray, new: np.ndarray, shoulders: float) -
         across = (1 - w) * neck + w * s * np.array([shoulders, 1.0])
         y, tilt, a, b, n, z = ring
         height = new[1] + s * (y - old[1])
-        if k >= len(rings) - 2:  # the bust reaches at least as far down as the default's
-            height = min(height, y)
+        if k >= len(rings) - len(BUST_END):  # far enough down for long hair's framing
+            height = min(height, BUST_END[k - len(rings)])
         ring[:] = (height, s * tilt, a * across[0], b * across[1], n, new[2] + s * (z - old[2]))
     return rings
 
@@ -353,7 +359,8 @@ def make_hair(head: dict, bust: dict, doc: dict, spec: dict,
             f"{key}_vertices": built["vertices"].astype(np.float16),
             f"{key}_triangles": built["triangles"].astype(np.uint16),
             f"{key}_colors": built["colors"], f"{key}_ao": built["ao"],
-            f"{key}_uv": built["uv"]}
+            f"{key}_uv": built["uv"],
+            "hairline": np.array(hairline["points"], np.float32)}  # for the pixel tests
     np.savez_compressed(HEAD / f"{spec['name']}_hair.npz", **hair)
 
 
