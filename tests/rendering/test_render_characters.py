@@ -36,18 +36,24 @@ def _hairline(name: str) -> np.ndarray:
 
 def _scalp_points(face, line: np.ndarray, vertices: np.ndarray,
                   renderer: FaceRenderer) -> np.ndarray:
-    """Pixels ``(N, 2) int`` of skin vertices well above the hairline facing the camera."""
-    skin = face.parts["skin"].vertex_ids
-    rest = face.vertices[skin].astype(np.float64)
+    """Pixels ``(N, 2) int`` of skin points well above the hairline facing the camera: the
+    skin's vertices and its triangles' centres (more points than the vertices alone, for a
+    head smaller in the frame than the default's)."""
+    part = face.parts["skin"]
+    skin = part.vertex_ids
+    tris = part.triangles
+    rest = np.concatenate([face.vertices[skin], face.vertices[tris].mean(1)]).astype(np.float64)
+    normals = vertex_normals(vertices, face.triangles)
+    normals = np.concatenate([normals[skin], normals[tris].mean(1)])
+    at = np.concatenate([vertices[skin], vertices[tris].mean(1)])
     centre_z = (rest[:, 2].min() + rest[:, 2].max()) / 2
     azimuth = np.degrees(np.abs(np.arctan2(rest[:, 0], rest[:, 2] - centre_z)))
     above = rest[:, 1] - np.interp(azimuth, line[:, 0], line[:, 1])
-    normals = vertex_normals(vertices, face.triangles)[skin]
-    to_camera = renderer.camera_pose[:3, 3] - vertices[skin]
+    to_camera = renderer.camera_pose[:3, 3] - at
     to_camera /= np.linalg.norm(to_camera, axis=1, keepdims=True)
-    facing = np.einsum("ij,ij->i", normals, to_camera) > 0.4
-    pick = skin[(above > ABOVE_MM / 1000) & facing & (rest[:, 1] > 0.06)]
-    pixels = np.round(renderer.project(vertices[pick])).astype(int)
+    facing = np.einsum("ij,ij->i", normals, to_camera) > 0.4 * np.linalg.norm(normals, axis=1)
+    pick = (above > ABOVE_MM / 1000) & facing & (rest[:, 1] > 0.06)
+    pixels = np.round(renderer.project(at[pick])).astype(int)
     inside = (pixels[:, 0] >= 0) & (pixels[:, 0] < W) & (pixels[:, 1] >= 0) & (pixels[:, 1] < H)
     return pixels[inside]
 
@@ -56,6 +62,7 @@ def _scalp_points(face, line: np.ndarray, vertices: np.ndarray,
 def test_no_scalp_skin_shows_above_a_characters_hairline(name) -> None:
     face, bald = load_face(name), load_face(name, hair="none")
     line = _hairline(name)
+    checked = 0
     for framing in ("face", "head", "bust"):
         for yaw in (0.0, 30.0):
             moved, bare = _yawed(face, yaw), _yawed(bald, yaw)
@@ -64,8 +71,15 @@ def test_no_scalp_skin_shows_above_a_characters_hairline(name) -> None:
                 points = _scalp_points(bald, line, bare, renderer)
             with FaceRenderer(bald, width=W, height=H, framing=framing) as renderer:
                 skin = renderer.frame(bare).astype(int)
-            assert len(points) > 10, (name, framing, yaw)
+            # the face framing at the front shows no scalp at all (brows to chin); a receding
+            # hairline leaves few scalp points facing a camera in front
+            assert len(points) >= (0 if framing == "face" and yaw == 0 else 3), (
+                name, framing, yaw, len(points))
+            checked += len(points)
+            if not len(points):
+                continue
             at_hair = haired[points[:, 1], points[:, 0]]
             at_skin = skin[points[:, 1], points[:, 0]]
             skin_like = np.abs(at_hair - at_skin).sum(1) < 40
             assert skin_like.mean() < 0.03, (name, framing, yaw, skin_like.mean())
+    assert checked > 100, (name, checked)
