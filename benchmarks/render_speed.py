@@ -87,15 +87,17 @@ def _double_sided_look():
 class _InProcess:
     """A FaceRenderer measured in this process."""
 
-    def __init__(self, renderer, vertices: np.ndarray):
-        self.renderer, self.vertices = renderer, vertices
+    def __init__(self, renderer, vertices: np.ndarray, faps: np.ndarray):
+        self.renderer, self.vertices, self.faps = renderer, vertices, faps
         self.mode = renderer.antialias
         renderer.frame(vertices[0])  # warm up: shaders compiled, buffers made
 
     def measure(self, frames: int) -> tuple[float, float]:
+        # each frame with its FAPs, as render() draws it (they deepen the skin's wrinkles)
         start, start_main = time.process_time(), time.thread_time()
         for i in range(frames):
-            self.renderer.frame(self.vertices[i % len(self.vertices)])
+            k = i % len(self.vertices)
+            self.renderer.frame(self.vertices[k], faps=self.faps[k])
         return ((time.process_time() - start) / frames,
                 (time.thread_time() - start_main) / frames)
 
@@ -165,7 +167,7 @@ def _renderers(faces: dict, stream, args, width: int, height: int) -> dict:
                 continue
             r = FaceRenderer(face, width=width, height=height, antialias=args.antialias,
                              **options)
-            out[f"{label}{tag}"] = _InProcess(r, vertices)
+            out[f"{label}{tag}"] = _InProcess(r, vertices, stream.values[: args.frames])
         samples = 0 if out[label].mode == "off" else 4
         try:
             out[f"{label}: ceiling"] = _Child(label, args, samples, out[label].renderer)

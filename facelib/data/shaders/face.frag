@@ -24,6 +24,19 @@
 // reflected inside the fibre comes out. The card is cut into HAIR_STRANDS strands across,
 // each a little lighter or darker and ending a little earlier (HAIR_TIPS), so a card reads
 // as a lock of hair, not a ribbon. Both faces of a card are lit (normal toward the viewer).
+//
+// Skin with a wrinkle layout (primitives with texcoord_1, facelib/rendering/skin_map.py)
+// gets three more things:
+//   wrinkles: two channels of (phase s, depth a); the skin is creased where s is a whole
+//     number: the valley profile v = ((1 + cos 2 pi s) / 2)^WRINKLE_SHARPNESS darkens the
+//     colour by 1 - WRINKLE_CREASE * a * v and tilts the normal across the line by the
+//     slope of the height -a * v (WRINKLE_BUMP), along the world-space gradient of s (from
+//     screen derivatives, as the hair's tangent); lines finer than about three pixels fade
+//     out instead of aliasing;
+//   scattering: the wrap is wider in red and narrower in blue (SKIN_SCATTER), so the
+//     terminator warms as light scattered under the skin comes out red;
+//   shine: the specular times a per-vertex factor (tangent.z; the look's skin_tint
+//     "shine": an oilier forehead and nose).
 
 struct DirectionalLight {
     vec3 color;
@@ -52,6 +65,29 @@ in float occlusion;
 out vec4 frag_color;
 
 const float PI = 3.141592653589793;
+
+#ifdef TEXCOORD_1_LOC
+in vec4 wrinkle;
+in float shine;
+
+// the crease of one wrinkle channel (phase s, depth a, world-space gradient g of s):
+// tilts n and returns the darkening factor
+float crease(float s, float a, vec3 g, inout vec3 n)
+{
+    a *= clamp(1.6 - 3.0 * fwidth(s), 0.0, 1.0);
+    if (a <= 0.002) {
+        return 1.0;
+    }
+    float k = float(WRINKLE_SHARPNESS);
+    float base = 0.5 + 0.5 * cos(2.0 * PI * s);
+    float valley = pow(base, k);
+    float slope = a * k * PI * pow(base, k - 1.0) * sin(2.0 * PI * s);
+    vec3 gt = g - n * dot(n, g);
+    gt /= max(length(gt), 1e-20);
+    n = normalize(n - float(WRINKLE_BUMP) * slope * gt);
+    return 1.0 - float(WRINKLE_CREASE) * a * valley;
+}
+#endif
 
 #ifdef TEXCOORD_0_LOC
 in vec2 hair_uv;
@@ -112,6 +148,25 @@ void main()
                                       + float(HAIR_SHEEN) * strand_lobe(t2, h, 0.25 * float(HAIR_GLOSS)) * 4.0 * base);
     }
 #else
+#ifdef TEXCOORD_1_LOC
+    vec3 dp1 = dFdx(world_position);
+    vec3 dp2 = dFdy(world_position);
+    vec3 across = cross(dp1, dp2);
+    vec3 g0 = dFdx(wrinkle.x) * cross(dp2, across) + dFdy(wrinkle.x) * cross(across, dp1);
+    vec3 g1 = dFdx(wrinkle.z) * cross(dp2, across) + dFdy(wrinkle.z) * cross(across, dp1);
+    float folded = crease(wrinkle.x, wrinkle.y, g0, n) * crease(wrinkle.z, wrinkle.w, g1, n);
+    base *= folded;
+    vec3 wraps = wrap * (vec3(1.0) + float(SKIN_SCATTER) * vec3(0.8, -0.15, -0.4));
+    for (int i = 0; i < n_directional_lights; i++) {
+        vec3 l = -normalize(directional_lights[i].direction);
+        vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
+        float nl = dot(n, l);
+        diffuse += radiance * max((vec3(nl) + wraps) / (vec3(1.0) + wraps), 0.0);
+        float nh = max(dot(n, normalize(l + v)), 0.0);
+        specular += radiance * (lobe * shine * pow(nh, shininess) * max(nl, 0.0));
+    }
+    specular *= folded;
+#else
     for (int i = 0; i < n_directional_lights; i++) {
         vec3 l = -normalize(directional_lights[i].direction);
         vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
@@ -120,6 +175,7 @@ void main()
         float nh = max(dot(n, normalize(l + v)), 0.0);
         specular += radiance * (lobe * pow(nh, shininess) * max(nl, 0.0));
     }
+#endif
 #endif
     vec3 color = base * (diffuse / PI + ambient_light) + occlusion * specular;
     frag_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);

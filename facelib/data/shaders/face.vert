@@ -14,6 +14,14 @@ layout(location = COLOR_0_LOC) in vec4 color_0;
 layout(location = TEXCOORD_0_LOC) in vec2 texcoord_0;  // hair cards: (card + across, root to tip)
 out vec2 hair_uv;
 #endif
+#ifdef TEXCOORD_1_LOC
+// skin with a wrinkle layout (facelib/rendering/skin_map.py): channel 0 (phase, depth) in
+// texcoord_1, channel 1 (phase, depth) and the skin's shine factor in the tangent
+layout(location = TEXCOORD_1_LOC) in vec2 texcoord_1;
+layout(location = TANGENT_LOC) in vec4 tangent;
+out vec4 wrinkle;
+out float shine;
+#endif
 layout(location = INST_M_LOC) in mat4 inst_m;
 
 uniform mat4 M;
@@ -34,6 +42,10 @@ void main()
     world_normal = mat3(transpose(inverse(model))) * normal;
 #ifdef TEXCOORD_0_LOC
     hair_uv = texcoord_0;
+#endif
+#ifdef TEXCOORD_1_LOC
+    wrinkle = vec4(texcoord_1, tangent.xy);
+    shine = tangent.z;
 #endif
 #ifdef COLOR_0_LOC
     albedo = color_0.rgb;
