@@ -386,7 +386,9 @@ def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
     old = getattr(renderer, "_program_cache", None)
     if not isinstance(old, base):
         return
-    shading = {name.upper(): float(value) for name, value in look.shading.items()}
+    # a look made before the skin's shading numbers existed draws smooth, unscattered skin
+    shading = {"WRINKLE_BUMP": 0.0, "WRINKLE_CREASE": 0.0, "SKIN_SCATTER": 0.0}
+    shading.update({name.upper(): float(value) for name, value in look.shading.items()})
 
     class _FaceProgramCache(base):  # type: ignore[valid-type,misc]  # pyrender is untyped
         def __init__(self, shader_dir: str | None = None):
@@ -523,20 +525,42 @@ class FaceRenderer:
             self._open(antialias)
 
     def _skin_maps(self, face: Deformable, vertices: np.ndarray) -> None:
-        """Per piece: the wrinkle layout of the skin (None elsewhere, and where the face
-        lacks the feature points it needs), the skin's tint and shine factors, and no
-        wrinkle activation yet (see :meth:`set_faps`)."""
+        """Cut each skin piece in two: the triangles that a wrinkle region reaches, which the
+        face shader creases, and the rest, spared that work (llvmpipe runs every branch of
+        a shader for every pixel). Per piece then: the wrinkle layout (None elsewhere, and
+        where the face lacks the feature points it needs), the skin's tint and surface
+        (shine, roughness) factors, and no wrinkle activation yet (see :meth:`set_faps`)."""
         from facelib.rendering.skin_map import skin_layout, tint_factors, wrinkle_drivers
 
         normals = vertex_normals(vertices, self._triangles, self._normal_op)
         self._drivers = wrinkle_drivers()
         self._activation = np.zeros(len(self._drivers.names), np.float32)
-        self._layouts = [skin_layout(face, p.vertex_ids, normals[p.vertex_ids], self._drivers)
-                         if p.name == "skin" else None for p in self._pieces]
+        pieces: list[PartMesh] = []
+        for piece in self._pieces:
+            layout = (skin_layout(face, piece.vertex_ids, normals[piece.vertex_ids],
+                                  self._drivers) if piece.name == "skin" else None)
+            if layout is None:
+                pieces.append(piece)
+                continue
+            reached = layout.weights.max(axis=(0, 2))[piece.triangles].max(axis=1) > 0
+            for part in (piece.triangles[reached], piece.triangles[~reached]):
+                if len(part):
+                    used = np.unique(part)
+                    pieces.append(PartMesh(piece.name, piece.vertex_ids[used],
+                                           np.searchsorted(used, part).astype(np.uint32),
+                                           piece.double_sided))
+        self._pieces = pieces
+        self._layouts = [None] * len(pieces)
+        for k, piece in enumerate(pieces):
+            if piece.name == "skin":
+                layout = skin_layout(face, piece.vertex_ids, normals[piece.vertex_ids],
+                                     self._drivers)
+                if layout is not None and layout.weights.any():
+                    self._layouts[k] = layout
         tints = [tint_factors(face, p.vertex_ids, normals[p.vertex_ids], self.look.skin_tint)
-                 if p.name == "skin" else None for p in self._pieces]
+                 if p.name == "skin" else None for p in pieces]
         self._tints = [None if t is None else t[0] for t in tints]
-        self._shine = [None if t is None else t[1] for t in tints]
+        self._surface = [None if t is None else t[1] for t in tints]
 
     def set_faps(self, faps: np.ndarray | None) -> None:
         """Deepen the skin's wrinkles as ``faps`` ``(84,)`` (one frame's FAP values, FAP
@@ -563,8 +587,8 @@ class FaceRenderer:
         if layout is not None:
             depth = layout.amplitudes(self._activation)
             buf = self._interleaved[piece]
-            buf[:, 11] = depth[:, 0]
-            buf[:, 7] = depth[:, 1]
+            buf[:, 7] = depth[:, 0]
+            buf[:, 9] = depth[:, 1]
 
     def _buffers(self, face: Deformable, colors: np.ndarray) -> None:
         """Per piece: linear colours with the occlusion factor in alpha, materials, hair
@@ -581,21 +605,24 @@ class FaceRenderer:
                         for p, tint in zip(self._pieces, self._tints, strict=True)]
         self._materials = [self._material(p) for p in self._pieces]
         self._uv = _piece_uv(self._pieces, getattr(face, "hair_uv", None))
-        # pyrender interleaves position, normal, then tangent (skin with wrinkles: phase and
-        # depth of channel 1, shine), texcoord_0 (hair only), texcoord_1 (skin with
-        # wrinkles: phase and depth of channel 0) and colour
+        # pyrender interleaves position, normal, then tangent (skin that wrinkles: phase and
+        # depth of channels 0 and 1), texcoord_0 (hair: card coordinates), texcoord_1 (skin:
+        # shine and roughness factors) and colour
         self._interleaved = []
         for k, (color, uv, layout) in enumerate(zip(self._colors, self._uv, self._layouts,
                                                    strict=True)):
-            width = 10 + (0 if uv is None else 2) + (0 if layout is None else 6)
+            surface = self._surface[k]
+            width = (10 + (0 if uv is None else 2) + (0 if layout is None else 4)
+                     + (0 if surface is None else 2))
             buf = np.zeros((len(color), width), np.float32)
             buf[:, -4:] = color
             if uv is not None:
                 buf[:, 6:8] = uv
             if layout is not None:
-                buf[:, 6] = layout.phase[:, 1]
-                buf[:, 8] = 1.0 if self._shine[k] is None else self._shine[k]
-                buf[:, 10] = layout.phase[:, 0]
+                buf[:, 6] = layout.phase[:, 0]
+                buf[:, 8] = layout.phase[:, 1]
+            if surface is not None:
+                buf[:, width - 6 : width - 4] = surface
             self._interleaved.append(buf)
 
     def _context(self, scale: int) -> Any:
@@ -677,13 +704,14 @@ class FaceRenderer:
                 self._pieces, self._colors, self._materials, self._uv, strict=True)):
             wrinkled = self._layouts[k] is not None
             buf = self._interleaved[k]
+            surface = buf[:, -6:-4] if self._surface[k] is not None else None
             self._write_wrinkles(k)
             primitive = pr.Primitive(
                 positions=vertices[piece.vertex_ids],
                 normals=normals[piece.vertex_ids],
                 tangents=buf[:, 6:10] if wrinkled else None,
                 texcoord_0=uv,
-                texcoord_1=buf[:, 10:12] if wrinkled else None,
+                texcoord_1=surface,
                 color_0=color,
                 indices=piece.triangles,
                 material=material,

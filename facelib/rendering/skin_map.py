@@ -214,16 +214,17 @@ def skin_layout(face: Any, vertex_ids: np.ndarray, normals: np.ndarray,
 
 def tint_factors(face: Any, vertex_ids: np.ndarray, normals: np.ndarray,
                  tints: Mapping[str, Mapping[str, Any]]) -> tuple[np.ndarray, np.ndarray]:
-    """``(colour (V, 3), shine (V,))`` float32 factors of ``face``'s vertices
+    """``(colour (V, 3), surface (V, 2))`` float32 factors of ``face``'s vertices
     ``vertex_ids`` from the look's ``skin_tint`` regions: an ellipse of ``half_size`` ES
-    around ``centre`` (as in ``regions.json``) multiplies the linear colour by ``colour`` and
-    the specular by ``shine`` (default 1) at its middle, easing to 1 at its rim; ones where
-    the face lacks what a region needs."""
+    around ``centre`` (as in ``regions.json``) multiplies the linear colour by ``colour``,
+    the specular by ``shine`` and the roughness by ``roughness`` (``surface``'s two columns;
+    each default 1) at its middle, easing to 1 at its rim; ones where the face lacks what a
+    region needs."""
     out = np.ones((len(vertex_ids), 3), np.float32)
-    shine = np.ones(len(vertex_ids), np.float32)
+    surface = np.ones((len(vertex_ids), 2), np.float32)
     framed = _frame_points(face)
     if framed is None:
-        return out, shine
+        return out, surface
     pts, es = framed
     p = np.asarray(face.vertices, np.float64)[vertex_ids][:, :2]
     frontal = _frontal(np.asarray(normals, np.float64))
@@ -233,8 +234,9 @@ def tint_factors(face: Any, vertex_ids: np.ndarray, normals: np.ndarray,
         d = p - _point(spec["centre"], pts, es)
         half = np.asarray(spec["half_size"], np.float64) * es
         r = np.hypot(d[:, 0] / half[0], d[:, 1] / half[1])
-        weight = np.clip(1.0 - r, 0.0, 1.0) ** 2 * frontal
+        weight = (np.clip(1.0 - r, 0.0, 1.0) ** 2 * frontal)[:, None]
         colour = np.asarray(spec.get("colour", (1.0, 1.0, 1.0)), np.float64)
-        out *= (1.0 + weight[:, None] * (colour - 1.0)).astype(np.float32)
-        shine *= (1.0 + weight * (float(spec.get("shine", 1.0)) - 1.0)).astype(np.float32)
-    return out, shine
+        out *= (1.0 + weight * (colour - 1.0)).astype(np.float32)
+        factors = np.array([float(spec.get("shine", 1.0)), float(spec.get("roughness", 1.0))])
+        surface *= (1.0 + weight * (factors - 1.0)).astype(np.float32)
+    return out, surface
