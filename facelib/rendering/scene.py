@@ -40,6 +40,13 @@ from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
 from facelib.rendering.readback import install_colour_readback
 from facelib.rendering.rigid_pieces import RigidGroup, rigid_groups, rigid_pose
+from facelib.rendering.skin_map import (
+    SkinLayout,
+    skin_layout,
+    tint_factors,
+    wrinkle_activation,
+    wrinkle_drivers,
+)
 
 __all__ = [
     "ANTIALIAS",
@@ -530,8 +537,6 @@ class FaceRenderer:
         a shader for every pixel). Per piece then: the wrinkle layout (None elsewhere, and
         where the face lacks the feature points it needs), the skin's tint and surface
         (shine, roughness) factors, and no wrinkle activation yet (see :meth:`set_faps`)."""
-        from facelib.rendering.skin_map import skin_layout, tint_factors, wrinkle_drivers
-
         normals = vertex_normals(vertices, self._triangles, self._normal_op)
         self._drivers = wrinkle_drivers()
         self._activation = np.zeros(len(self._drivers.names), np.float32)
@@ -550,7 +555,7 @@ class FaceRenderer:
                                            np.searchsorted(used, part).astype(np.uint32),
                                            piece.double_sided))
         self._pieces = pieces
-        self._layouts = [None] * len(pieces)
+        self._layouts: list[SkinLayout | None] = [None] * len(pieces)
         for k, piece in enumerate(pieces):
             if piece.name == "skin":
                 layout = skin_layout(face, piece.vertex_ids, normals[piece.vertex_ids],
@@ -565,8 +570,6 @@ class FaceRenderer:
     def set_faps(self, faps: np.ndarray | None) -> None:
         """Deepen the skin's wrinkles as ``faps`` ``(84,)`` (one frame's FAP values, FAP
         units; None: smooth skin) asks, from the next frame drawn on."""
-        from facelib.rendering.skin_map import wrinkle_activation
-
         if faps is None:
             activation = np.zeros_like(self._activation)
         else:
