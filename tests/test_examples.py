@@ -83,3 +83,25 @@ def test_expressive_storyboard_moves_the_brows():
     brow = faps.values[:, fap("raise_l_i_eyebrow").index]
     assert brow.max() > 80 and brow.min() < -5
     assert faps.values[:, fap("open_jaw").index].max() > 300   # it speaks
+
+
+def test_dialogue_storyboard_has_two_characters_speaking_in_turn():
+    pytest.importorskip("espeakng_loader")
+    from facelib import run_scene
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = run_scene(EXAMPLES / "dialogue" / "dialogue.fdl")
+    ada, ben = scene.parts["ada"], scene.parts["ben"]
+    assert ada.visemes[-1].end_ms <= ben.visemes[0].start_ms  # Ben answers after Ada
+    jaw = fap("open_jaw").index
+    frames = np.arange(scene.n_frames) * 40
+    for speaker, listener in ((ada, ben), (ben, ada)):
+        talking = np.zeros(scene.n_frames, bool)
+        for span in speaker.visemes:
+            if span.name != "sil":
+                talking |= (frames >= span.start_ms) & (frames < span.end_ms)
+        assert speaker.faps.values[talking, jaw].max() > 300
+        assert np.abs(listener.faps.values[talking, jaw]).max() < 40  # lips only for the speaker
+    assert [c.who for c in scene.storyboard.camera] == ["ben", None]
+    assert scene.speech_audio.samples.size > 6 * scene.speech_audio.sample_rate

@@ -110,7 +110,7 @@ def check_who(parts: ModernParts, ctx: Context) -> None:
                            path=ctx.path, line=line)
         if who not in names:
             raise FdlError(f"{kind}: who = {who!r} is not one of the characters "
-                           f"({', '.join(names)}){did_you_mean(who, names)}",
+                           f"({', '.join(names)}){did_you_mean(who, names, cutoff=0.6)}",
                            path=ctx.path, line=line)
 
 

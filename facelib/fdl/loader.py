@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 import warnings
 from pathlib import Path
 from typing import TypeVar
@@ -270,7 +271,7 @@ def _cast(
         if _global(chunk, setting) is not None:
             raise FdlError(f"{setting}: with characters, give each character's {setting} in "
                            f'characters {{ name = {{ {setting} = "..." }} }}',
-                           path=ctx.path, line=_line(ctx.source, setting))
+                           path=ctx.path, line=_assignment_line(ctx.source, setting))
     language = _language(chunk, ctx)
     characters = []
     for index, draft in enumerate(parts.characters):
@@ -299,6 +300,16 @@ def _cast(
         expression_mixes=parts.expression_mixes,
         camera=scene_camera(camera_cues(parts.camera, ctx), ctx),
         characters=tuple(characters))
+
+
+def _assignment_line(text: str, name: str) -> int | None:
+    """The line of a top-level ``name = ...`` (one that starts a line, not a table field
+    such as a character's ``hair = ...``), else the first ``name =`` anywhere."""
+    pattern = re.compile(rf"^\s*{re.escape(name)}\s*=(?!=)")
+    for number, line in enumerate(text.splitlines(), start=1):
+        if pattern.match(line):
+            return number
+    return _line(text, name)
 
 
 def _language(chunk: ChunkResult, ctx: Context) -> str | None:

@@ -270,15 +270,7 @@ def read_say(
     """``say "text"`` or ``say { "text" or transcript/audio/visemes, at, who }``: the
     speech (of character ``who`` in a storyboard with characters)."""
     who = who_of(arg, "say", ctx, line) if isinstance(arg, LuaTable) else None
-    earlier = parts.speech if who is None else parts.speeches.get(who)
-    if earlier is not None:
-        whose = "a storyboard has" if who is None else f"character {who!r} has"
-        raise FdlError(
-            f"say is called a second time{'' if who is None else f' for {who!r}'} (the "
-            f"first call is on line {earlier.line}); {whose} one speech",
-            path=ctx.path,
-            line=line,
-        )
+    _check_first_say(parts, who, ctx, line)
     if isinstance(arg, str):
         parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
         return
@@ -325,6 +317,20 @@ def read_say(
         parts.speech = said
     else:
         parts.speeches[who] = said
+
+
+def _check_first_say(parts: ModernParts, who: str | None, ctx: Context,
+                     line: int | None) -> None:
+    """FdlError when the storyboard (or character ``who``) already has its one ``say``."""
+    earlier = parts.speech if who is None else parts.speeches.get(who)
+    if earlier is not None:
+        whose = "a storyboard has" if who is None else f"character {who!r} has"
+        raise FdlError(
+            f"say is called a second time{'' if who is None else f' for {who!r}'} (the "
+            f"first call is on line {earlier.line}); {whose} one speech",
+            path=ctx.path,
+            line=line,
+        )
 
 
 def _style(fields: Mapping[str, LuaValue], ctx: Context, line: int | None) -> str | float:

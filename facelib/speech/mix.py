@@ -13,7 +13,6 @@ from math import gcd
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import resample_poly
 
 from facelib.speech.audio import _read_file
 
@@ -48,6 +47,8 @@ def mix_voices(voices: Sequence[Voice]) -> tuple[np.ndarray, int]:
     loaded = [(_samples(v), v.offset) for v in voices]
     if not loaded:
         return np.zeros(0, np.float32), 16_000
+    from scipy.signal import resample_poly  # loaded on first use (import facelib stays light)
+
     rate = max(r for (_, r), _ in loaded)
     pieces = []
     for (raw, own), offset in loaded:
