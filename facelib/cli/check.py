@@ -37,10 +37,10 @@ def _check(args: argparse.Namespace, console: Console) -> int:
     else:
         faps = animate(storyboard, seed=args.seed).faps
     print(describe(storyboard))
-    target = default_output(args.story, storyboard.output, ".fap")
+    target = str(default_output(args.story, storyboard.output, ".fap"))
     if storyboard.characters:
         names = ", ".join(c.name for c in storyboard.characters)
-        target = f"{target} as one file per character ({names})"
+        target += f" as one file per character ({names})"
     console.status(f"ok: {faps.n_frames} frames at {faps.fps:g} fps "
                    f"({faps.duration:.2f} s); 'facelib run' without -o writes "
                    f"{target}")

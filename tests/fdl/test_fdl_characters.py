@@ -52,20 +52,20 @@ def test_a_character_face_is_a_file_inside_the_storyboard_folder(tmp_path):
     assert sb.characters[0].face is None
     assert sb.characters[1].face == (tmp_path / "ben.json").resolve()
     assert sb.characters[1].part.face == sb.characters[1].face
-    with pytest.raises(FdlError, match="t.fdl:1: characters: ada: face"):
+    with pytest.raises(FdlError, match=r"t\.fdl:1: characters: ada: face"):
         fdl.loads('characters { ada = { face = "../x.json" } }', name="t.fdl",
                   base_dir=tmp_path)
 
 
 @pytest.mark.parametrize(("body", "message"), [
     ('say { who = "bne", "Hi." }',
-     r"t\.fdl:5: say: who = 'bne' is not one of the characters \(ada, ben\); "
-     r"did you mean 'ben'\?"),
+     (r"t\.fdl:5: say: who = 'bne' is not one of the characters \(ada, ben\); "
+      r"did you mean 'ben'\?")),
     ('show { who = "adda", "joy", dur = 1 }',
      r"t\.fdl:5: show: who = 'adda' is not one of the characters .*did you mean 'ada'\?"),
     ('look { "lookTo", "left", 10, dur = 1 }',
-     r"t\.fdl:5: look: this storyboard names characters \(ada, ben\); say whose it is "
-     r"with who = \"ada\""),
+     (r"t\.fdl:5: look: this storyboard names characters \(ada, ben\); say whose it is "
+      r"with who = \"ada\"")),
     ('say { who = "ada", "a" }\nsay { who = "ada", "b" }',
      r"t\.fdl:6: say is called a second time for 'ada' \(the first call is on line 5\)"),
     ('camera { "head", at = 1 }',
