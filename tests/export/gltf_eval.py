@@ -19,7 +19,8 @@ _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 
 class Gltf:
     def __init__(self, path: Path):
-        self.g = pygltflib.GLTF2.load(str(path))
+        binary = Path(path).read_bytes()[:4] == b"glTF"  # .glb, .vrm, .vrma
+        self.g = (pygltflib.GLTF2.load_binary if binary else pygltflib.GLTF2.load)(str(path))
         self.blob = self.g.binary_blob()
 
     def _view(self, index: int, dtype: type, count: int, width: int, offset: int = 0):
