@@ -114,3 +114,12 @@ def test_the_scene_is_the_same_for_the_same_seed_and_differs_for_another():
     for name in ("ada", "ben"):
         assert one.parts[name].faps == two.parts[name].faps
         assert one.parts[name].faps != other.parts[name].faps
+
+
+def test_commands_that_play_one_face_refuse_characters_clearly(tmp_path, capsys):
+    story = tmp_path / "dialogue.fdl"
+    story.write_text(DIALOGUE)
+    assert main(["plot", str(story), "-o", str(tmp_path / "x.png")]) != 0
+    assert "names characters (ada, ben)" in capsys.readouterr().err
+    assert main(["run", str(story), "-o", "-"]) != 0
+    assert "one .fap per character" in capsys.readouterr().err
