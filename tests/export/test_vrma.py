@@ -145,12 +145,15 @@ def test_three_vrm_plays_the_animation_on_facelibs_avatar(motion, tmp_path):
     assert report["meta"] == "1" and set(report["expressions"]) == set(preset_names())
     assert {"Normalized_head.quaternion", "VRMLookAtQuaternionProxy.quaternion",
             "VRMExpression_aa.weight"} <= set(report["tracks"])
+    # one mesh per part, named for it (three.js keeps the glTF node names)
+    assert sorted(report["frames"][0]["influences"]) == sorted(avatar.parts)
     for i, shown in zip(frames, report["frames"], strict=True):
         for k, name in enumerate(result.presets):
             assert shown["weights"][name] == pytest.approx(result.weights[i, k], abs=1e-5), name
-            # facelib's avatar binds preset k to its own morph target k at weight 1
-            assert shown["influences"][preset_names().index(name)] == pytest.approx(
-                result.weights[i, k], abs=1e-5)
+            # facelib's avatar binds preset k to morph target k of every part at weight 1
+            for part, influences in shown["influences"].items():
+                assert influences[preset_names().index(name)] == pytest.approx(
+                    result.weights[i, k], abs=1e-5), (part, name)
         yaw, pitch, _ = Rotation.from_quat(shown["head"]).as_euler("YXZ", degrees=True)
         assert (yaw, pitch) == pytest.approx((20 * i / 49, -8 * i / 49), abs=0.05)
         assert shown["look"] == pytest.approx([15 * i / 49, 10 * i / 49], abs=0.05)

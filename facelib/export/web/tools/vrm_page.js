@@ -2,7 +2,8 @@
 // and a .vrma with @pixiv/three-vrm-animation (both given as base64 in window.FACELIB_VRM),
 // plays the animation on the avatar with three.js's AnimationMixer, and reports, per asked
 // time, what the avatar shows: every expression's weight, the head bone's normalized
-// rotation, the look-at's yaw and pitch, and the mesh's morph target influences.
+// rotation, the look-at's yaw and pitch, and the morph target influences of every part mesh
+// (facelib writes one mesh per part, named for it: "skin", "eye_l" ...).
 import * as THREE from "three";
 import { GLTFLoader } from "three/examples/jsm/loaders/GLTFLoader.js";
 import { VRMLoaderPlugin } from "@pixiv/three-vrm";
@@ -38,8 +39,8 @@ async function main() {
     report.tracks = clip.tracks.map((t) => t.name);
     const mixer = new THREE.AnimationMixer(vrm.scene);
     mixer.clipAction(clip).play();
-    let mesh = null;
-    vrm.scene.traverse((o) => { if (o.isMesh && o.morphTargetInfluences && !mesh) mesh = o; });
+    const meshes = [];
+    vrm.scene.traverse((o) => { if (o.isMesh && o.morphTargetInfluences) meshes.push(o); });
     for (const t of job.times) {
       mixer.setTime(t);
       vrm.update(0);
@@ -50,7 +51,7 @@ async function main() {
         weights,
         head: vrm.humanoid.getNormalizedBoneNode("head").quaternion.toArray(),
         look: [vrm.lookAt.yaw, vrm.lookAt.pitch],
-        influences: Array.from(mesh.morphTargetInfluences),
+        influences: Object.fromEntries(meshes.map((m) => [m.name, Array.from(m.morphTargetInfluences)])),
       });
     }
   }
