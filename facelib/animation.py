@@ -26,6 +26,7 @@ from facelib.speech.mix import Voice, mix_voices
 from facelib.sync import Liveliness, SyncRules, combine
 from facelib.visemes.animate import SpeechAudio, VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
+from facelib.visemes.turns import join_turns
 
 __all__ = ["Animation", "Scene", "animate", "animate_scene", "compose", "definition_line",
            "run_fdl", "run_scene", "speech_track"]
@@ -170,9 +171,10 @@ def _speech(storyboard: Storyboard, *, max_frames: int) -> tuple[VisemeAnimation
             f"storyboard {storyboard.path or '(in memory)'} lasts {storyboard.cues_end_ms} ms "
             f"= {n_frames} frames at {fps:g} fps, more than max_frames={max_frames}"
         )
-    speech = (visemes.animate(storyboard.speech, fps=fps, max_frames=max_frames,
-                              language=storyboard.language)
-              if storyboard.speech else None)
+    said = [s for s in (storyboard.speech, *storyboard.turns) if s is not None]
+    turns = [(s, visemes.animate(s, fps=fps, max_frames=max_frames,
+                                 language=storyboard.language)) for s in said]
+    speech = None if not turns else turns[0][1] if len(turns) == 1 else join_turns(turns)
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
     return speech, n_frames
@@ -189,8 +191,8 @@ def _animation(
         speaking=None if speech is None else speech.speaking, n_frames=n_frames, rules=rules,
         report=report, liveliness=liveliness)
     return Animation(
-        faps=stream,
-        audio=storyboard.speech.audio if storyboard.speech else None,
+        faps=stream,  # several turns: their sound is mixed into speech_audio
+        audio=storyboard.speech.audio if storyboard.speech and not storyboard.turns else None,
         storyboard=storyboard,
         audio_offset=storyboard.speech.start_ms / 1000 if storyboard.speech else 0.0,
         tracks=tracks,

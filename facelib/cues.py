@@ -200,6 +200,8 @@ class Storyboard:
         two-shot shows them (each with its own part, :class:`Character`); then ``speech``,
         ``expressions``, ``gaze`` and ``moods`` are empty and ``camera`` cuts between them.
         Empty for a storyboard of one face.
+    turns: what the face says after ``speech``, in time order: the later ``say`` calls of
+        a character (its turns in a dialogue; a storyboard of one face has one ``say``).
     """
 
     path: Path | None = None
@@ -219,6 +221,7 @@ class Storyboard:
     camera: tuple[CameraCue, ...] = ()
     moods: tuple[MoodCue, ...] = ()
     characters: tuple[Character, ...] = ()
+    turns: tuple[SpeechSpec, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
@@ -235,6 +238,7 @@ class Storyboard:
         ends += [c.start_ms for c in self.moods]
         ends += [c.end_ms for c in self.camera]
         ends += [c.part.cues_end_ms for c in self.characters]
-        if self.speech is not None and self.speech.visemes:
-            ends += [c.end_ms for c in self.speech.visemes]
+        for said in (self.speech, *self.turns):
+            if said is not None and said.visemes:
+                ends += [c.end_ms for c in said.visemes]
         return max(ends, default=0)

@@ -93,7 +93,12 @@ def test_dialogue_storyboard_has_two_characters_speaking_in_turn():
         warnings.simplefilter("ignore")
         scene = run_scene(EXAMPLES / "dialogue" / "dialogue.fdl")
     ada, ben = scene.parts["ada"], scene.parts["ben"]
-    assert ada.visemes[-1].end_ms <= ben.visemes[0].start_ms  # Ben answers after Ada
+    said = {name: [(s.start_ms, s.end_ms) for s in anim.visemes if s.name != "sil"]
+            for name, anim in scene.parts.items()}
+    assert not any(a0 < b1 and b0 < a1 for a0, a1 in said["ada"] for b0, b1 in said["ben"])
+    turns = sorted((s[0], name) for name, spans in said.items() for s in spans)
+    order = [name for i, (_, name) in enumerate(turns) if i == 0 or turns[i - 1][1] != name]
+    assert order == ["ada", "ben", "ada", "ben"]  # they speak in turn
     jaw = fap("open_jaw").index
     frames = np.arange(scene.n_frames) * 40
     for speaker, listener in ((ada, ben), (ben, ada)):
@@ -103,5 +108,5 @@ def test_dialogue_storyboard_has_two_characters_speaking_in_turn():
                 talking |= (frames >= span.start_ms) & (frames < span.end_ms)
         assert speaker.faps.values[talking, jaw].max() > 300
         assert np.abs(listener.faps.values[talking, jaw]).max() < 40  # lips only for the speaker
-    assert [c.who for c in scene.storyboard.camera] == ["ben", None]
+    assert [c.who for c in scene.storyboard.camera] == ["ben", "ada", None]
     assert scene.speech_audio.samples.size > 6 * scene.speech_audio.sample_rate

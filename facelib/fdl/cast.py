@@ -20,6 +20,7 @@ read by the same rules as a storyboard of one face; the camera cuts between them
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -94,7 +95,7 @@ def check_who(parts: ModernParts, ctx: Context) -> None:
     names = [c.name for c in parts.characters]
     calls: list[tuple[str, str | None, int | None]] = [
         (kind, d.who, d.line) for kind, d in _drafts(parts)]
-    calls += [("say", s.who, s.line) for s in parts.speeches.values()]
+    calls += [("say", s.who, s.line) for turns in parts.speeches.values() for s in turns]
     if parts.speech is not None:
         calls.append(("say", None, parts.speech.line))
     for kind, who, line in sorted(calls, key=lambda c: c[2] or 0):
@@ -114,15 +115,22 @@ def check_who(parts: ModernParts, ctx: Context) -> None:
                            path=ctx.path, line=line)
 
 
-def part_of(parts: ModernParts, name: str) -> ModernParts:
-    """The calls of character ``name``: its speech, expressions, eye behaviours and moods,
-    and the definitions every character shares (no camera, no characters)."""
+def part_of(parts: ModernParts, name: str, ctx: Context) -> ModernParts:
+    """The calls of character ``name``: its speech (its first ``say``, then its turns, by
+    start; FdlError for two starting together), expressions, eye behaviours and moods, and
+    the definitions every character shares (no camera, no characters)."""
     def own(drafts: Sequence[DraftCue]) -> list[DraftCue]:
         return [replace(d, who=None) for d in drafts if d.who == name]
 
-    said = parts.speeches.get(name)
+    said = sorted(parts.speeches.get(name, ()), key=lambda s: s.at_ms)
+    for before, after in itertools.pairwise(said):
+        if after.at_ms == before.at_ms:
+            raise FdlError(f"say: {name}'s turns on lines {before.line} and {after.line} both "
+                           f"start at {after.at_ms} ms; give each turn its own at = ...",
+                           path=ctx.path, line=after.line)
     return ModernParts(
-        speech=None if said is None else replace(said, who=None),
+        speech=replace(said[0], who=None) if said else None,
+        turns=[replace(s, who=None) for s in said[1:]],
         expressions=own(parts.expressions), gaze=own(parts.gaze), moods=own(parts.moods),
         expression_defs=parts.expression_defs, expression_mixes=parts.expression_mixes,
         gaze_defs=parts.gaze_defs)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from facelib.cues import Origin, Storyboard
+from facelib.cues import Origin, SpeechSpec, Storyboard
 
 __all__ = ["describe"]
 
@@ -46,10 +46,12 @@ def describe(sb: Storyboard) -> str:
 
 
 def _speech(sb: Storyboard) -> list[str]:
-    """The speech and its stored visemes, one per line."""
-    s = sb.speech
-    if s is None:
-        return []
+    """The speech (and the turns after it) with stored visemes, one per line."""
+    return [line for s in (sb.speech, *sb.turns) if s is not None for line in _said(s)]
+
+
+def _said(s: SpeechSpec) -> list[str]:
+    """One speech and its stored visemes, one per line."""
     text = "" if s.text is None else repr(s.text if len(s.text) < 60 else s.text[:57] + "...")
     out = [(f"speech at {s.start_ms / 1000:.3f}s: audio={s.audio or 'none'} "
             f"text={text or 'none'}{_where(s.origin)}")]

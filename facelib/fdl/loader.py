@@ -275,12 +275,13 @@ def _cast(
     language = _language(chunk, ctx)
     characters = []
     for index, draft in enumerate(parts.characters):
-        own = part_of(parts, draft.name)
+        own = part_of(parts, draft.name, ctx)
         face = (None if draft.face is None else _face_file(
             draft.face, ctx, what=f"characters: {draft.name}: face", line=draft.line))
         part = Storyboard(
             path=file, fps=ctx.fps, language=language, seed=_part_seed(seed, index),
             speech=None if own.speech is None else modern_cues.speech_spec(own.speech, ctx),
+            turns=tuple(modern_cues.speech_spec(t, ctx) for t in own.turns),
             expressions=_by_start(modern_cues.expression_cues(own.expressions, ctx)),
             gaze=_by_start(modern_cues.gaze_cues(own.gaze, ctx)),
             expression_defs=parts.expression_defs, gaze_defs=parts.gaze_defs,
@@ -292,7 +293,8 @@ def _cast(
                                     origin=ctx.origin(draft.line)))
     output = _output(chunk, fdl, fdl_line, ctx)
     if output is not None:
-        inputs = [file, *(p for c in characters for p in _inputs_of(c.part.speech))]
+        inputs = [file, *(p for c in characters for s in (c.part.speech, *c.part.turns)
+                          for p in _inputs_of(s))]
         _check_output(output, inputs=tuple(inputs), ctx=ctx)
     return Storyboard(
         path=file, fps=ctx.fps, seed=seed, language=language, output=output,

@@ -94,10 +94,12 @@ class ModernParts:
     """Everything the storyboard-function calls asked for, in call order.
 
     ``speech`` is the one ``say`` of a storyboard of one face; ``speeches`` holds the
-    ``say`` of each character (``who =``) of a storyboard that names ``characters``."""
+    ``say`` calls of each character (``who =``) of a storyboard that names ``characters``;
+    ``turns`` the ``say`` calls after the first of one character's part."""
 
     speech: DraftSpeech | None = None
-    speeches: dict[str, DraftSpeech] = field(default_factory=dict)
+    speeches: dict[str, list[DraftSpeech]] = field(default_factory=dict)
+    turns: list[DraftSpeech] = field(default_factory=list)
     characters: list[DraftCharacter] = field(default_factory=list)
     expressions: list[DraftCue] = field(default_factory=list)
     gaze: list[DraftCue] = field(default_factory=list)
@@ -270,7 +272,7 @@ def read_say(
     """``say "text"`` or ``say { "text" or transcript/audio/visemes, at, who }``: the
     speech (of character ``who`` in a storyboard with characters)."""
     who = who_of(arg, "say", ctx, line) if isinstance(arg, LuaTable) else None
-    _check_first_say(parts, who, ctx, line)
+    _check_first_say(parts, ctx, line)
     if isinstance(arg, str):
         parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
         return
@@ -316,18 +318,16 @@ def read_say(
     if who is None:
         parts.speech = said
     else:
-        parts.speeches[who] = said
+        parts.speeches.setdefault(who, []).append(said)
 
 
-def _check_first_say(parts: ModernParts, who: str | None, ctx: Context,
-                     line: int | None) -> None:
-    """FdlError when the storyboard (or character ``who``) already has its one ``say``."""
-    earlier = parts.speech if who is None else parts.speeches.get(who)
-    if earlier is not None:
-        whose = "a storyboard has" if who is None else f"character {who!r} has"
+def _check_first_say(parts: ModernParts, ctx: Context, line: int | None) -> None:
+    """FdlError when the storyboard already has its one ``say`` (a character of a
+    storyboard with characters, ``who = ...``, may speak several times)."""
+    if parts.speech is not None:
         raise FdlError(
-            f"say is called a second time{'' if who is None else f' for {who!r}'} (the "
-            f"first call is on line {earlier.line}); {whose} one speech",
+            f"say is called a second time (the first call is on line {parts.speech.line}); "
+            "a storyboard has one speech (characters, say { who = ... }, may have several)",
             path=ctx.path,
             line=line,
         )

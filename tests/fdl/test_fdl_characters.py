@@ -67,7 +67,7 @@ def test_a_character_face_is_a_file_inside_the_storyboard_folder(tmp_path):
      (r"t\.fdl:5: look: this storyboard names characters \(ada, ben\); say whose it is "
       r"with who = \"ada\"")),
     ('say { who = "ada", "a" }\nsay { who = "ada", "b" }',
-     r"t\.fdl:6: say is called a second time for 'ada' \(the first call is on line 5\)"),
+     r"t\.fdl:6: say: ada's turns on lines 5 and 6 both start at 0 ms"),
     ('camera { "head", at = 1 }',
      r"t\.fdl:5: camera: with characters a cue names who = \.\.\. .* got framing 'head'"),
     ('camera { who = "ben", at = 1, dur = 1 }',
@@ -109,3 +109,21 @@ def test_describe_lists_each_character_and_its_cues():
     assert "character ada: face bundled, hair long" in text
     assert "character ben: face bundled, hair short" in text
     assert "speech at 1.000s" in text and "ben (render framing) (cut)" in text
+
+
+def test_a_character_may_speak_several_turns_in_time_order():
+    sb = _load('say { who = "ada", "Coffee?", at = 4 }\n'
+               'say { who = "ada", "Morning.", at = 0.5 }\n'
+               'say { who = "ben", "Please.", at = 2 }\n')
+    ada, ben = sb.characters
+    assert ada.part.speech.text == "Morning." and ada.part.speech.start_ms == 500
+    assert [t.text for t in ada.part.turns] == ["Coffee?"]
+    assert ada.part.turns[0].origin == ("t.fdl", 5)
+    assert ben.part.turns == ()
+    assert fdl.describe(sb).count("speech at") == 3
+
+
+def test_a_storyboard_of_one_face_still_has_one_say():
+    with pytest.raises(FdlError, match=r"t\.fdl:2: say is called a second time \(the first "
+                                       r"call is on line 1\); a storyboard has one speech"):
+        fdl.loads('say "a"\nsay "b"', name="t.fdl")

@@ -123,3 +123,20 @@ def test_commands_that_play_one_face_refuse_characters_clearly(tmp_path, capsys)
     assert "names characters (ada, ben)" in capsys.readouterr().err
     assert main(["run", str(story), "-o", "-"]) != 0
     assert "one .fap per character" in capsys.readouterr().err
+
+
+def test_a_character_speaks_several_turns_on_one_stream_and_soundtrack():
+    scene = animate_scene(fdl.loads(DIALOGUE + 'say { who = "ada", "Coffee, then?", at = 6 }'))
+    ada, ben = scene.parts["ada"], scene.parts["ben"]
+    jaw = fap("open_jaw").index
+    starts = [s.start_ms for s in ada.visemes if s.name != "sil"]
+    assert min(starts) < 1000 and max(starts) > 6000  # both of her turns
+    times = np.arange(scene.n_frames) * 40
+    second = (times > 6100) & (times < 7000)
+    assert ada.faps.values[second, jaw].max() > 300
+    assert np.abs(ben.faps.values[second, jaw]).max() < 40
+    # her two turns are one voice from her first turn on, both on the soundtrack
+    assert ada.audio is None and ada.audio_offset == pytest.approx(0.2)
+    rate = scene.speech_audio.sample_rate
+    late = scene.speech_audio.samples[round(6.1 * rate):round(7.0 * rate)]
+    assert np.sqrt(np.mean(late ** 2)) > 0.02
