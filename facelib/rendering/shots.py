@@ -104,7 +104,7 @@ def iter_scene_frames(
             for k, (first, stop) in enumerate(cols):
                 pose, znear, zfar = two_shot[k]
                 renderers[k].set_camera(pose, znear=znear, zfar=zfar)
-                full = renderers[k].frame(vertices[k])
+                full = renderers[k].frame(vertices[k], faps=scene.clips[k].stream.values[i])
                 left = (width - (stop - first)) // 2
                 image[:, first:stop] = full[:, left:left + stop - first]
         else:
@@ -112,7 +112,8 @@ def iter_scene_frames(
             k = scene.names.index(who)
             pose, znear, zfar = close[(who, shot.framing or framing)]
             renderers[k].set_camera(pose, znear=znear, zfar=zfar)
-            image[:] = renderers[k].frame(vertices[k])
+            # the frame's FAPs deepen the skin's wrinkles, as in a render of one face
+            image[:] = renderers[k].frame(vertices[k], faps=scene.clips[k].stream.values[i])
         yield image.copy()
         if report is not None:
             report(i + 1, scene.n_frames)
