@@ -15,7 +15,14 @@ alignment (pocketsphinx) and plotting (matplotlib) load on first use.
 from typing import TYPE_CHECKING, Any
 
 from facelib import expressions, fdl, gaze, mpeg4, sync, visemes
-from facelib.animation import Animation, animate, run_fdl
+from facelib.animation import (
+    Animation,
+    Scene,
+    animate,
+    animate_scene,
+    run_fdl,
+    run_scene,
+)
 from facelib.errors import (
     ArkitFormatError,
     DataError,
@@ -49,6 +56,7 @@ _LAZY = {
     "load_face": "facelib.engine",
     "render": "facelib.rendering.frames",
     "render_still": "facelib.rendering.frames",
+    "render_scene": "facelib.rendering.shots",
     "save_png": "facelib.rendering.frames",
     "view": "facelib.rendering.viewer",
     "plot_curves": "facelib.plot",
@@ -102,12 +110,14 @@ __all__ = [
     "ParameterError",
     "PronunciationWarning",
     "RenderError",
+    "Scene",
     "SpeechError",
     "SpeechWarning",
     "TrackingError",
     "TrackingWarning",
     "__version__",
     "animate",
+    "animate_scene",
     "arkit_residuals",
     "export_arkit",
     "export_gltf",
@@ -128,8 +138,10 @@ __all__ = [
     "plot_curves",
     "read_fap",
     "render",
+    "render_scene",
     "render_still",
     "run_fdl",
+    "run_scene",
     "save_png",
     "setup_face",
     "sync",
