@@ -25,6 +25,8 @@ from facelib.errors import FaceModelError
 __all__ = ["Character", "character_names", "characters", "face_definition"]
 
 LIST = "head/characters.json"
+DEFAULT = "default"
+"""The name of the default head (``face = "default"``, ``--face default``)."""
 
 
 @dataclass(frozen=True)
@@ -54,7 +56,8 @@ def face_definition(face: str | os.PathLike[str] | None) -> Path | None:
     """The face definition JSON that ``face`` names; None for None (the default head).
 
     ``face``: an existing face definition file, a folder holding ``face.json`` (what
-    ``facelib face setup`` writes), or the name of a bundled character; a path that does
+    ``facelib face setup`` writes), the name of a bundled character, or ``"default"`` (the
+    default head's definition); a path that does
     not exist is returned as it is (the reader then says so). FaceModelError naming the
     characters, with a did-you-mean, for a bare name that is neither a character nor an
     existing file.
@@ -68,6 +71,8 @@ def face_definition(face: str | os.PathLike[str] | None) -> Path | None:
     if path.exists() or not is_bare_name(text):
         return path
     found = {c.name: c.definition for c in characters()}
+    if text == DEFAULT:
+        return Path(str(data.path("head/default_head.json")))
     if text in found:
         return found[text]
     raise FaceModelError(f"no character or face definition named {text!r} (characters: "

@@ -143,3 +143,15 @@ def test_the_commands_take_a_character(tmp_path, capsys):
     story.write_text('fps = 25\nface = "adaa"\n')
     assert main(["check", str(story)]) != 0
     assert "story.fdl:2" in capsys.readouterr().err
+
+
+def test_a_dialogue_character_may_be_a_bundled_character(tmp_path):
+    story = tmp_path / "d.fdl"
+    story.write_text('characters {\n  ada = { face = "ada" },\n  ben = { face = "bne" },\n}\n'
+                     'say { who = "ada", "Hi." }\nsay { who = "ben", "Hello." }\n')
+    board = load(story)
+    assert [c.face for c in board.characters] == ["ada", "bne"]
+    assert storyboard_definition(board.characters[0].part) == face_definition("ada")
+    with pytest.raises(FdlError, match=r"d\.fdl:3.*did you mean 'ben'\?"):
+        storyboard_definition(board.characters[1].part)
+    assert face_definition("default") == face_definition("ada").parent / "default_head.json"
