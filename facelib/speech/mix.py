@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facelib.speech.audio import _read_file
+from facelib.speech.audio import read_sound
 
 __all__ = ["Voice", "mix_voices"]
 
@@ -34,7 +34,7 @@ class Voice:
 def _samples(voice: Voice) -> tuple[np.ndarray, int]:
     """``(n,) float64`` mono samples of ``voice`` and their rate."""
     if voice.file is not None:
-        data, rate = _read_file(Path(voice.file))
+        data, rate = read_sound(Path(voice.file))
     else:
         data, rate = np.asarray(voice.samples, np.float64), int(voice.sample_rate)
     return (data.mean(axis=1) if data.ndim == 2 else data), rate
