@@ -42,7 +42,14 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from facelib.errors import FacelibError  # noqa: E402
-from facelib.speech.acoustic import HOP, AcousticModel, log_mel, model_from_arrays  # noqa: E402
+from facelib.speech.acoustic import (  # noqa: E402
+    HOP,
+    AcousticModel,
+    LevelState,
+    causal_normalize,
+    log_mel,
+    model_from_arrays,
+)
 from facelib.speech.audio import ALIGN_RATE, load_speech  # noqa: E402
 from facelib.speech.espeak import synth_fresh  # noqa: E402
 from facelib.speech.synth import events_to_timeline  # noqa: E402
@@ -350,12 +357,14 @@ def warp_features(x: np.ndarray, starts: np.ndarray, rng: np.random.Generator) -
 
 
 def save(net: object, args: argparse.Namespace, *, mean: np.ndarray, scale: np.ndarray,
-         hidden: tuple[int, ...], hours: float, accuracy: float, epochs: int,
-         seconds: float) -> None:
+         init: np.ndarray | None, hidden: tuple[int, ...], hours: float, accuracy: float,
+         epochs: int, seconds: float) -> None:
     """Write the model's ``.npz`` (front end, weights, how it was made)."""
     arrays = {**front_end(), "mean": mean, "scale": scale, **_dummy_net(),
               "n_layers": np.array(len(net.coefs_)),  # type: ignore[attr-defined]
               "switch_penalty": np.array(args.penalty)}
+    if init is not None:
+        arrays["level_init"] = init
     for k, (w, b) in enumerate(zip(net.coefs_, net.intercepts_,  # type: ignore[attr-defined]
                                    strict=True)):
         arrays[f"w{k}"] = w.astype(np.float32)
@@ -367,6 +376,7 @@ def save(net: object, args: argparse.Namespace, *, mean: np.ndarray, scale: np.n
         "train_variants": list(TRAIN_VARIANTS), "held_out_voices": sorted(HELD_OUT_VOICES),
         "held_out_variants": list(HELD_OUT_VARIANTS), "offsets": list(OFFSETS),
         "n_mels": N_MELS, "n_fft": N_FFT, "lag": LAG, "feature_warp": bool(args.feature_warp),
+        "level_normalisation": init is not None,
         "validation_frame_accuracy": round(accuracy, 4), "seconds": round(seconds),
         "synthesis": "libespeak-ng (espeakng-loader wheel); no Festival voice",
     }
@@ -374,6 +384,18 @@ def save(net: object, args: argparse.Namespace, *, mean: np.ndarray, scale: np.n
     args.out.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(args.out, **arrays)
     print(f"wrote {args.out} ({args.out.stat().st_size / 1e6:.2f} MB)", flush=True)
+
+
+def normalize_all(x: np.ndarray, starts: np.ndarray, init: np.ndarray | None) -> np.ndarray:
+    """:func:`causal_normalize` of each utterance of ``x`` from the state ``init`` (or ``x``
+    itself when ``init`` is None: no level normalisation)."""
+    if init is None:
+        return x
+    out = np.empty_like(x)
+    ends = np.append(starts[1:], x.shape[0])
+    for a, b in zip(starts, ends, strict=True):
+        out[a:b] = causal_normalize(x[a:b], LevelState(None, init))[0]
+    return out
 
 
 def main() -> None:
@@ -386,6 +408,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path,
                         default=ROOT / "facelib" / "data" / "visemes" / "acoustic_model.npz")
     parser.add_argument("--penalty", type=float, default=4.0)
+    parser.add_argument("--cmn", type=int, default=0,
+                        help="1: causal level and channel normalisation of the features")
     parser.add_argument("--feature-warp", type=int, default=1,
                         help="1: warp the features of every epoch after the first")
     args = parser.parse_args()
@@ -404,9 +428,16 @@ def main() -> None:
     print(f"data: {x.shape[0] / 100 / 3600:.2f} h train, {xv.shape[0] / 100 / 60:.1f} min "
           f"validation, {time.time() - t0:.0f} s", flush=True)
     floor = np.log(np.full(N_MELS, 1e-8, np.float32))
+    raw = x
+    init = None
+    if args.cmn:
+        loud = x.mean(axis=1) > np.percentile(x.mean(axis=1), 50)
+        init = x[loud].mean(axis=0).astype(np.float32)
+        x = normalize_all(x, starts, init)
+        xv = normalize_all(xv, sv, init)
+        floor = floor - init
     mean = x.mean(axis=0).astype(np.float32)
     scale = x.std(axis=0).astype(np.float32) + 1e-3
-    raw = x
     x = (x - mean) / scale
     xv = (xv - mean) / scale
     pad = ((floor - mean) / scale).astype(np.float32)
@@ -422,8 +453,8 @@ def main() -> None:
     for epoch in range(args.epochs):
         if epoch == int(args.epochs * 0.75):
             net._optimizer.learning_rate_init = 3e-4  # adam's step, late epochs
-        xe = ((warp_features(raw, starts, rng) - mean) / scale).astype(np.float32) \
-            if args.feature_warp and epoch > 0 else x
+        xe = ((normalize_all(warp_features(raw, starts, rng), starts, init) - mean)
+              / scale).astype(np.float32) if args.feature_warp and epoch > 0 else x
         order = rng.permutation(x.shape[0])
         for k in range(0, order.size, chunk):
             rows = np.sort(order[k:k + chunk])
@@ -431,7 +462,8 @@ def main() -> None:
         acc = float(np.mean(net.predict(xv_stacked) == yv))
         print(f"epoch {epoch + 1}: validation frames right {100 * acc:.1f} % "
               f"({time.time() - t0:.0f} s)", flush=True)
-        save(net, args, mean=mean, scale=scale, hidden=hidden, hours=x.shape[0] / 360000,
+        save(net, args, mean=mean, scale=scale, init=init, hidden=hidden,
+             hours=x.shape[0] / 360000,
              accuracy=acc, epochs=epoch + 1, seconds=time.time() - t0)
 
 

@@ -28,8 +28,9 @@ from facelib.errors import DataError
 from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.timeline import PhoneTimeline, Span, append_span
 
-__all__ = ["MODEL_FILE", "AcousticModel", "AcousticStream", "frame_classes", "load_model",
-           "log_mel", "recognize_acoustic"]
+__all__ = ["MODEL_FILE", "AcousticModel", "AcousticStream", "LevelState", "causal_normalize",
+           "classes_to_spans", "frame_classes", "frame_log_probs", "load_model", "log_mel",
+           "network_input", "recognize_acoustic", "start_level"]
 
 MODEL_FILE = "visemes/acoustic_model.npz"
 HOP = ALIGN_RATE // 100
@@ -48,7 +49,9 @@ class AcousticModel:
     float32 (ReLU between layers, softmax at the end); labels: ``(n_classes,)`` the IPA
     phone standing for each class (class k is viseme k, ``"SIL"`` for 0); lag: frames the
     Viterbi pass waits before deciding; switch_penalty: its cost (log probability) of a
-    change of viseme; info: how it was made (JSON text).
+    change of viseme; info: how it was made (JSON text); level_init: ``(n_mels,)`` the
+    running mean spectrum :func:`causal_normalize` starts from, or None where the model
+    takes the log-mel spectra as they are.
     """
 
     mel: np.ndarray
@@ -62,6 +65,7 @@ class AcousticModel:
     lag: int
     switch_penalty: float
     info: str
+    level_init: np.ndarray | None = None
 
     @property
     def look_ahead_ms(self) -> float:
@@ -84,7 +88,9 @@ def model_from_arrays(arrays: dict[str, np.ndarray]) -> AcousticModel:
         weights=tuple(np.asarray(arrays[f"w{k}"], np.float32) for k in range(n_layers)),
         biases=tuple(np.asarray(arrays[f"b{k}"], np.float32) for k in range(n_layers)),
         labels=tuple(str(x) for x in arrays["labels"]), lag=int(arrays["lag"]),
-        switch_penalty=float(arrays["switch_penalty"]), info=str(arrays["info"]))
+        switch_penalty=float(arrays["switch_penalty"]), info=str(arrays["info"]),
+        level_init=(np.asarray(arrays["level_init"], np.float32) if "level_init" in arrays
+                    else None))
 
 
 @cache
@@ -102,8 +108,8 @@ def load_model(path: str | None = None) -> AcousticModel:
 
 def log_mel(samples: np.ndarray, model: AcousticModel, *, first: int = 0,
             n_frames: int | None = None) -> np.ndarray:
-    """``(n_frames, n_mels) float32`` normalised log-mel spectra of frames ``first ...``
-    of ``samples`` (``(n,)`` at 16 kHz); frame ``i`` is the Hann window of ``n_fft``
+    """``(n_frames, n_mels) float32`` log-mel spectra (natural log of the power) of frames
+    ``first ...`` of ``samples`` (``(n,)`` at 16 kHz); frame ``i`` is the Hann window of ``n_fft``
     samples centred at sample ``80 + 160 i``, zeros outside ``samples``. By default every
     frame whose centre lies inside ``samples``."""
     if n_frames is None:
@@ -120,14 +126,64 @@ def log_mel(samples: np.ndarray, model: AcousticModel, *, first: int = 0,
     frames = np.lib.stride_tricks.sliding_window_view(chunk, model.n_fft)[::HOP][:n_frames]
     window = np.hanning(model.n_fft + 1)[:-1].astype(np.float32)
     power = np.abs(np.fft.rfft(frames * window, axis=1)) ** 2
-    mel = np.log(power.astype(np.float32) @ model.mel.T + _FLOOR)
-    return ((mel - model.mean) / model.scale).astype(np.float32)
+    return np.log(power.astype(np.float32) @ model.mel.T + _FLOOR).astype(np.float32)
+
+
+def start_level(model: AcousticModel) -> LevelState:
+    """The level state at the start of a recording."""
+    init = model.level_init if model.level_init is not None else np.zeros(model.mean.size)
+    return LevelState(None, np.asarray(init, np.float64))
+
+
+def network_input(raw: np.ndarray, model: AcousticModel, state: LevelState
+                  ) -> tuple[np.ndarray, LevelState]:
+    """The network's per-frame input ``(n, n_mels) float32`` of log-mel frames ``raw``
+    (:func:`log_mel`; level-normalised when the model says so, then standardised) and
+    the level state after them."""
+    if model.level_init is not None:
+        raw, state = causal_normalize(raw, state)
+    return ((raw - model.mean) / model.scale).astype(np.float32), state
+
+
+@dataclass(frozen=True, slots=True)
+class LevelState:
+    """What :func:`causal_normalize` carries from frame to frame: ``peak``, the running
+    peak of the frames' mean log power (None before the first frame), and ``mean``
+    ``(n_mels,)``, the running mean spectrum of the loud frames."""
+
+    peak: float | None
+    mean: np.ndarray
+
+
+CMN_RATE = 0.01
+"""Weight of each loud frame in the running mean spectrum (a time constant of 1 s)."""
+PEAK_DECAY = 0.02
+"""How fast the running peak falls (natural log power per frame: 2 per second)."""
+LOUD_BELOW_PEAK = 2.5
+"""A frame is loud when its mean log power is within this of the running peak."""
+
+
+def causal_normalize(raw: np.ndarray, state: LevelState) -> tuple[np.ndarray, LevelState]:
+    """``raw`` log-mel frames ``(n, n_mels)`` minus the running mean spectrum of the loud
+    frames up to each (level and channel taken out, causally), and the state after them."""
+    out = np.empty_like(raw)
+    peak, mean = state.peak, state.mean.astype(np.float64).copy()
+    level = raw.mean(axis=1)
+    for t in range(raw.shape[0]):
+        peak = float(level[t]) if peak is None else max(float(level[t]), peak - PEAK_DECAY)
+        if level[t] > peak - LOUD_BELOW_PEAK:
+            mean += CMN_RATE * (raw[t] - mean)
+        out[t] = raw[t] - mean
+    return out, LevelState(peak, mean)
 
 
 def _silence_feature(model: AcousticModel) -> np.ndarray:
-    """``(n_mels,)``: the feature of a frame of digital silence (padding beyond the audio)."""
-    return ((np.log(np.full(model.mean.size, _FLOOR, np.float32)) - model.mean)
-            / model.scale).astype(np.float32)
+    """``(n_mels,)``: the input of a frame of digital silence (padding beyond the audio;
+    level-normalised against the starting mean spectrum)."""
+    floor = np.log(np.full(model.mean.size, _FLOOR, np.float32))
+    if model.level_init is not None:
+        floor = floor - model.level_init
+    return ((floor - model.mean) / model.scale).astype(np.float32)
 
 
 def _network(stacked: np.ndarray, model: AcousticModel) -> np.ndarray:
@@ -143,7 +199,8 @@ def _network(stacked: np.ndarray, model: AcousticModel) -> np.ndarray:
 
 def frame_log_probs(features: np.ndarray, model: AcousticModel) -> np.ndarray:
     """``(n, n_classes)`` log probabilities of every frame of ``features`` ``(n, n_mels)``
-    (frames before the first and after the last count as digital silence)."""
+    (:func:`network_input`; frames before the first and after the last count as digital
+    silence)."""
     lo, hi = int(-model.offsets.min()), int(max(model.offsets.max(), 0))
     pad = _silence_feature(model)
     padded = np.concatenate([np.tile(pad, (lo, 1)), features, np.tile(pad, (hi, 1))])
@@ -169,6 +226,7 @@ class AcousticStream:
         self._features = np.zeros((0, m.mean.size), np.float32)  # frames _feature0 ...
         self._feature0 = 0
         self._n_total: int | None = None  # frames in all, once finished
+        self._level = start_level(m)
         self._n_scored = 0
         self._delta = np.zeros(m.n_classes)
         self._back: list[np.ndarray] = []  # back pointers of frames n_decided+1 ... n_scored-1
@@ -205,8 +263,9 @@ class AcousticStream:
     def _add_features(self, ready: int) -> None:
         first = self._n_features
         if ready > first:
-            local = log_mel(self._samples, self.model, first=first - self._sample0 // HOP,
-                            n_frames=ready - first)
+            raw = log_mel(self._samples, self.model, first=first - self._sample0 // HOP,
+                          n_frames=ready - first)
+            local, self._level = network_input(raw, self.model, self._level)
             self._features = np.concatenate([self._features, local])
         # the samples that later frames need start at 80 + 160 ready - n_fft / 2
         need = ready * HOP + HOP // 2 - self.model.n_fft // 2

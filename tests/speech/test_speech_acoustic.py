@@ -19,7 +19,9 @@ from facelib.speech.acoustic import (
     frame_log_probs,
     load_model,
     log_mel,
+    network_input,
     recognize_acoustic,
+    start_level,
 )
 from facelib.speech.audio import ALIGN_RATE
 from facelib.speech.recognize import recognize
@@ -55,8 +57,9 @@ def test_shipped_model_loads_and_is_small():
 def test_frame_probabilities_shape():
     model = load_model()
     x = _babble(1.0)
-    feats = log_mel(x, model)
-    assert feats.shape == (100, model.mean.size) and feats.dtype == np.float32
+    raw = log_mel(x, model)
+    assert raw.shape == (100, model.mean.size) and raw.dtype == np.float32
+    feats, _ = network_input(raw, model, start_level(model))
     logp = frame_log_probs(feats, model)
     assert logp.shape == (100, 15)
     np.testing.assert_allclose(np.exp(logp).sum(axis=1), 1, rtol=1e-5)
