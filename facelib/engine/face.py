@@ -182,8 +182,9 @@ class _Rigid:
     chin_drop: float  # its downward motion per unit of FAP 3 in the skin operator
     head_pivot: np.ndarray
     head_tiled: np.ndarray  # (3V,) float32, the pivot repeated per vertex
-    head_weights: np.ndarray  # (K,) float32 for the neck vertices
-    neck: np.ndarray  # (3K,) columns
+    head_weights: np.ndarray  # (K,) float32 in (0, 1) for the neck vertices
+    neck: np.ndarray  # (3K,) columns of the vertices the head turns in part (the neck)
+    still: np.ndarray  # (3S,) columns of the vertices it leaves (the bust)
 
 
 @dataclass(frozen=True, eq=False)
@@ -226,7 +227,7 @@ class Face:
     pivots: Mapping[str, np.ndarray]
     neck: tuple[np.ndarray, np.ndarray, float]
     operator: sp.csr_array = field(repr=False)
-    _columns: np.ndarray = field(repr=False)
+    _spans: tuple[tuple[int, int, int, int], ...] = field(repr=False)
     _dense: np.ndarray = field(repr=False)
     _rigid: _Rigid = field(repr=False)
     _steps: tuple[_Step, ...] = field(repr=False, default=())
@@ -268,8 +269,10 @@ class Face:
         operator, steps = _compile(verts, tris, points, fapu, regions)
         operator = riders.operator(operator)
         _check_rigid_eyes(regions, part_map)
-        columns = np.unique(operator.indices).astype(np.int64)
-        dense = operator[:, columns].toarray().astype(np.float32)
+        spans = _spans(np.unique(operator.indices))
+        dense = operator[:, np.concatenate([np.arange(a, b) for a, b, _, _ in spans]
+                                           + [np.zeros(0, np.int64)])]
+        dense = dense.toarray().astype(np.float32)
         rigid_parts = _rigid(verts, points, fapu, regions=_lids_with_riders(regions, riders),
                              parts=part_map, pivots=pivot_map, neck=neck, operator=operator)
         return cls(
@@ -284,7 +287,7 @@ class Face:
             neck=(_readonly(neck[0], np.float64), _readonly(neck[1], np.float64),
                   float(neck[2])),
             operator=operator,
-            _columns=columns,
+            _spans=spans,
             _dense=dense,
             _rigid=rigid_parts,
             _steps=steps,
@@ -375,21 +378,24 @@ class Face:
         if active is None:
             active = self._active(f)
         # frames go through in small blocks so that every pass stays in the CPU cache
-        buf = np.empty((_BLOCK, nv, 3), np.float32)
+        # (BLAS writes into fresh pages many times slower than into these warm ones)
+        buf, spare = np.empty((2, _BLOCK, nv, 3), np.float32)
         for a in range(0, n, _BLOCK):
             fb = f[a : a + _BLOCK]
             pos = buf[: len(fb)]
             flat = pos.reshape(len(fb), nv * 3)
             flat[:] = self.vertices.reshape(-1)
             if active.size:
-                flat[:, self._columns] += fb[:, active] @ self._dense[active]
+                moved = fb[:, active] @ self._dense[active]
+                for first, stop, i, j in self._spans:
+                    flat[:, first:stop] += moved[:, i:j]
             f64 = fb.astype(np.float64)
             for step in self._steps:
                 step.apply(flat, f64)
             self._move_lids(pos, f64)
             self._move_eyes(pos, f64)
             self._move_jaw(pos, f64)
-            self._move_head(pos, f64, out[a : a + _BLOCK])
+            out[a : a + _BLOCK] = self._move_head(pos, f64, spare[: len(fb)])
         return out
 
     def _move_lids(self, pos: np.ndarray, f: np.ndarray) -> None:
@@ -430,23 +436,46 @@ class Face:
         flat[:, r.jaw_z] = z + (thrust * self.fapu["MNS"]).astype(np.float32)[:, None]
         flat[:, r.jaw_x] -= (shift * self.fapu["MW"]).astype(np.float32)[:, None]
 
-    def _move_head(self, pos: np.ndarray, f: np.ndarray, out: np.ndarray) -> None:
-        """Rotate the block ``pos`` about the head pivot into ``out`` (same shape)."""
+    def _move_head(self, pos: np.ndarray, f: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The block ``pos`` rotated about the head pivot: ``out`` (same shape) filled, or
+        ``pos`` itself where the head stays still."""
         r = self._rigid
         au = self.fapu["AU"]
         pitch, yaw, roll = (f[:, _column(name)] * au for name in _HEAD)
         if not (pitch.any() or yaw.any() or roll.any()):
-            out[:] = pos
-            return
+            return pos
         nb = len(f)
         rot = rigid.rotation_matrices(pitch, yaw, roll)
-        flat = pos.reshape(nb, -1)
+        turned = np.ascontiguousarray(rot.transpose(0, 2, 1), dtype=np.float32)
+        flat, out_flat = pos.reshape(nb, -1), out.reshape(nb, -1)
         neck = flat[:, r.neck].reshape(nb, -1, 3)
+        still = flat[:, r.still]
         flat -= r.head_tiled
-        np.matmul(pos, rot.transpose(0, 2, 1).astype(np.float32), out=out)
-        out.reshape(nb, -1)[:] += r.head_tiled
-        out.reshape(nb, -1)[:, r.neck] = rigid.rotate_weighted(
+        for k in range(nb):  # one BLAS product per frame beats a stacked matmul here
+            np.dot(pos[k], turned[k], out=out[k])
+        out_flat += r.head_tiled
+        out_flat[:, r.neck] = rigid.rotate_weighted(
             neck, r.head_pivot, rot, r.head_weights).reshape(nb, -1)
+        out_flat[:, r.still] = still
+        return out
+
+
+def _spans(columns: np.ndarray, *, gap: int = 96) -> tuple[tuple[int, int, int, int], ...]:
+    """The operator's non-zero columns as a few contiguous spans of the ``(3V,)`` axis.
+
+    ``columns`` (C,) sorted unique ints. Runs closer than ``gap`` columns are joined (the
+    columns between them carry zeros), so the product lands through slices rather than a
+    fancy-indexed scatter. Returns ``(first, stop, i, j)`` per span: columns
+    ``first:stop`` of a frame take columns ``i:j`` of the compacted product.
+    """
+    if columns.size == 0:
+        return ()
+    breaks = np.flatnonzero(np.diff(columns) > gap)
+    firsts = columns[np.r_[0, breaks + 1]]
+    stops = columns[np.r_[breaks, columns.size - 1]] + 1
+    ends = np.cumsum(stops - firsts)
+    return tuple((int(a), int(b), int(e - (b - a)), int(e))
+                 for a, b, e in zip(firsts, stops, ends, strict=True))
 
 
 def _check_rigid_eyes(regions: tuple[Region, ...], parts: Mapping[str, Part]) -> None:
@@ -665,6 +694,7 @@ def _rigid(verts: np.ndarray, points: Mapping[str, int], fapu: Mapping[str, floa
         chin_drop=_jaw_drop(operator, points["2.3"], fapu["MNS"]),
         head_pivot=head,
         head_tiled=np.tile(head.astype(np.float32), len(verts)),
-        head_weights=head_w[head_w < 1.0].astype(np.float32),
-        neck=_columns(np.nonzero(head_w < 1.0)[0]),
+        head_weights=head_w[(head_w > 0.0) & (head_w < 1.0)].astype(np.float32),
+        neck=_columns(np.flatnonzero((head_w > 0.0) & (head_w < 1.0))),
+        still=_columns(np.flatnonzero(head_w <= 0.0)),
     )
