@@ -5,7 +5,8 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
@@ -108,6 +109,19 @@ class Scene:
 _STAGES = 4  # speech, expressions, gaze, synchronizer: the units of animate's progress
 
 
+@contextmanager
+def _naming(storyboard: Storyboard) -> Iterator[None]:
+    """Raise a generator's error that names no file again naming the storyboard (and the
+    line of the definition it concerns, where one can be found)."""
+    try:
+        yield
+    except FacelibError as exc:
+        if exc.path is not None or storyboard.path is None:
+            raise
+        raise type(exc)(exc.message, path=storyboard.path,
+                        line=definition_line(storyboard.path, exc.message)) from exc
+
+
 def animate(
     storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
     max_frames: int = MAX_FRAMES,
@@ -128,15 +142,10 @@ def animate(
     An error of a generator that names no file is raised again naming the storyboard (and
     the line of the definition it concerns, where one can be found).
     """
-    try:
+    with _naming(storyboard):
         return _animate(storyboard, seed=seed, rules=rules, max_frames=max_frames,
                         report=progress_callback(progress, "animating", unit="stages"),
                         liveliness=liveliness)
-    except FacelibError as exc:
-        if exc.path is not None or storyboard.path is None:
-            raise
-        raise type(exc)(exc.message, path=storyboard.path,
-                        line=definition_line(storyboard.path, exc.message)) from exc
 
 
 def _animate(
@@ -215,15 +224,10 @@ def animate_scene(
     soundtrack. ``seed`` overrides the storyboard's (character ``i`` takes ``seed + i``);
     ``progress`` is called as ``progress(done, 4 * n_characters)``; the other options as for
     :func:`animate`."""
-    try:
+    with _naming(storyboard):
         return _animate_scene(storyboard, seed=seed, rules=rules or SyncRules.load(),
                               max_frames=max_frames, liveliness=liveliness,
                               report=progress_callback(progress, "animating", unit="stages"))
-    except FacelibError as exc:
-        if exc.path is not None or storyboard.path is None:
-            raise
-        raise type(exc)(exc.message, path=storyboard.path,
-                        line=definition_line(storyboard.path, exc.message)) from exc
 
 
 def _animate_scene(

@@ -24,7 +24,7 @@ from facelib.progress import ProgressCallback, progress_callback
 from facelib.rendering.camera import CameraTrack, camera_of
 from facelib.rendering.protocols import Deformable, HasFaps
 from facelib.rendering.scene import FaceRenderer
-from facelib.rendering.video import open_writer, save_png
+from facelib.rendering.video import save_png, write_video
 
 __all__ = ["face_or_default", "iter_frames", "render", "render_still", "save_png",
            "speech_audio_file", "stream_of"]
@@ -142,8 +142,9 @@ def render(
             if out is None:
                 return _collect(frames, stream.n_frames, renderer.height, renderer.width)
             mp4_audio = sound if Path(out).suffix.lower() == ".mp4" else None
-            return _write(frames, out, stream, width=width, height=height, audio=mp4_audio,
-                          audio_offset=clip.audio_offset)
+            return write_video(frames, out, fps=stream.fps, duration=stream.duration,
+                               width=width, height=height, audio=mp4_audio,
+                               audio_offset=clip.audio_offset)
 
 
 def _collect(frames: Iterator[np.ndarray], n_frames: int, height: int, width: int
@@ -167,23 +168,6 @@ def _one_png(
         )
     return save_png(render_still(face, stream.values[0], width=width, height=height,
                                  background=background, framing=framing), out)
-
-
-def _write(
-    frames: Iterator[np.ndarray], out: str | os.PathLike[str], stream: FapStream, *,
-    width: int, height: int, audio: Path | None, audio_offset: float,
-) -> Path:
-    """Write ``frames`` (each ``(height, width, 3) uint8``) to ``out`` at the stream's
-    frame rate; a failure removes what was written."""
-    writer = open_writer(out, fps=stream.fps, width=width, height=height, audio=audio,
-                         audio_offset=audio_offset, duration=stream.duration)
-    try:
-        for image in frames:
-            writer.write(image)
-    except BaseException:
-        writer.abort()
-        raise
-    return writer.commit()
 
 
 def render_still(

@@ -26,7 +26,7 @@ from facelib.errors import ParameterError
 from facelib.progress import ProgressCallback, progress_callback
 from facelib.rendering.protocols import Deformable
 from facelib.rendering.scene import FaceRenderer, frame_camera, framing_points
-from facelib.rendering.video import open_writer
+from facelib.rendering.video import write_video
 
 __all__ = ["columns", "iter_scene_frames", "render_scene"]
 
@@ -165,12 +165,5 @@ def render_scene(
             sound = Path(folder) / "speech.wav"
             soundfile.write(str(sound), scene.speech.samples, scene.speech.sample_rate,
                             subtype="PCM_16")
-        writer = open_writer(out, fps=scene.fps, width=width, height=height, audio=sound,
-                             duration=scene.clips[0].stream.duration)
-        try:
-            for image in frames:
-                writer.write(image)
-        except BaseException:
-            writer.abort()
-            raise
-        return writer.commit()
+        return write_video(frames, out, fps=scene.fps, width=width, height=height,
+                           audio=sound, duration=scene.clips[0].stream.duration)

@@ -14,6 +14,7 @@ import struct
 import subprocess
 import tempfile
 import zlib
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Protocol
 
@@ -31,6 +32,7 @@ __all__ = [
     "open_writer",
     "probe_video",
     "save_png",
+    "write_video",
 ]
 
 _FRAME_NAME = "frame_{:06d}.png"
@@ -314,3 +316,27 @@ def open_writer(
     raise ParameterError(
         f"cannot tell what to write from {path.name!r}: use .mp4, .gif or a folder for PNG frames"
     )
+
+
+def write_video(
+    frames: Iterable[np.ndarray],
+    path: str | os.PathLike[str],
+    *,
+    fps: float,
+    width: int,
+    height: int,
+    audio: str | os.PathLike[str] | None = None,
+    audio_offset: float = 0.0,
+    duration: float | None = None,
+) -> Path:
+    """Write ``frames`` (each ``(height, width, 3) uint8``) through :func:`open_writer`
+    (same options) and return the path; a failure removes what was written."""
+    writer = open_writer(path, fps=fps, width=width, height=height, audio=audio,
+                         audio_offset=audio_offset, duration=duration)
+    try:
+        for image in frames:
+            writer.write(image)
+    except BaseException:
+        writer.abort()
+        raise
+    return writer.commit()
