@@ -29,6 +29,7 @@ touch where the source's do not).
 
 from __future__ import annotations
 
+import os
 import tempfile
 import time
 import tracemalloc
@@ -136,6 +137,39 @@ def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
     print(f"  MediaPipe face mesh, 640x480: {n / track_s:.0f} frames/s; brows from the image: "
           f"{n / brows_s:.0f} frames/s; landmarks to FAPs: {n / faps_s:.0f} frames/s; whole "
           f"path without decoding: {n / (track_s + brows_s + faps_s):.0f} frames/s")
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process and its finished children (ffmpeg's decoding), seconds: on
+    a machine shared with other jobs the figure that does not move with their load."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def video_speed(path: Path, repeats: int = 2) -> None:
+    """The whole video-to-FAP path (``track_video_faps``: decoding, detection, the brows'
+    image registration, the model, smoothing) against MediaPipe's own landmark speed on
+    the same frames (decoded beforehand, not timed), side by side in CPU time, the best of
+    ``repeats`` runs each (issue 37's goal: a ratio of 0.8 or more)."""
+    from facelib.tracking.video import read_video, track_video_faps
+
+    frames = list(read_video(path)[1])
+    track_video_faps(path, max_frames=10)  # warm: imports, the model, MediaPipe's graph
+    mediapipe_s = whole_s = float("inf")
+    for _ in range(repeats):
+        with FaceMeshTracker(video=True, max_faces=1) as tracker:
+            started = cpu_seconds()
+            for image in frames:
+                tracker.detect(image)
+            mediapipe_s = min(mediapipe_s, cpu_seconds() - started)
+        started = cpu_seconds()
+        track_video_faps(path)
+        whole_s = min(whole_s, cpu_seconds() - started)
+    n = len(frames)
+    print(f"\nvideo to FAPs, {path.name} ({n} frames, {frames[0].shape[1]}x{frames[0].shape[0]}"
+          f"), CPU time: MediaPipe's landmarks alone {n / mediapipe_s:.0f} frames/s, the whole "
+          f"path (decode, detection, brows, model, smoothing) {n / whole_s:.0f} frames/s: "
+          f"ratio {mediapipe_s / whole_s:.2f}")
 
 
 def traced(call: Callable[[], object]) -> tuple[float, int]:
