@@ -473,9 +473,11 @@ def main() -> None:
     values = np.concatenate([s.values for s in streams])
     lost = ~(np.isfinite(landmarks).all(axis=(1, 2)) & np.isfinite(brows).all(axis=1))
     print(f"{len(values)} frames, {int(lost.sum())} without a face (left out)")
+    segments = tuple(int((~part).sum()) for part in np.split(
+        lost, np.cumsum([len(t) for t in tracks])[:-1]))
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL),
                               components=args.components, brows=brows[~lost],
-                              regions=(gaze_region(),))
+                              regions=(gaze_region(),), segments=segments)
     if not args.no_write:
         write_lip_rule(*zip(*[(t, s) for t, s, h in zip(tracks, streams, heads, strict=True)
                               if not h], strict=True))
