@@ -111,6 +111,8 @@ SEEDS = (9, 10, 11)
 """The training streams' seeds: streams of 3000 frames (with one alone most FAPs of the
 closed loop correlate 0.01-0.12 less, a few 0.01-0.02 more; see docs/performance-driven.md).
 The third, since issue 37, on another face (``TRAIN_HEADS``)."""
+TRAIN_FRAMES = (3000, 3000, 1200)
+"""Frames of each training stream (the warped head's is shorter: rendering time)."""
 TRAIN_HEADS = (0, 0, 3)
 """The face each training stream is rendered on: 0 the default head, else the seed of a
 head warped from it (:func:`warped_head`; the validation's heads are seeds 1 and 2)."""
@@ -439,7 +441,9 @@ def validate(model: ObservationModel, fresh: bool) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=3000)
+    parser.add_argument("--frames", type=int, nargs="+", default=None,
+                        help=f"frames per stream (default {TRAIN_FRAMES} for the default "
+                        "seeds, else 3000 each)")
     parser.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
     parser.add_argument("--heads", type=int, nargs="+", default=None,
                         help="per seed: 0 the default head, N the head warped with seed N "
@@ -461,8 +465,14 @@ def main() -> None:
                            else [0] * len(args.seeds))
     if len(heads) != len(args.seeds):
         parser.error("give one --heads entry per seed")
-    streams = [training_stream(args.frames, seed, push=args.push, solo=args.solo)
-               for seed in args.seeds]
+    frames = args.frames or (list(TRAIN_FRAMES) if args.seeds == list(SEEDS)
+                             else [3000] * len(args.seeds))
+    if len(frames) == 1:
+        frames = frames * len(args.seeds)
+    if len(frames) != len(args.seeds):
+        parser.error("give one --frames entry, or one per seed")
+    streams = [training_stream(count, seed, push=args.push, solo=args.solo)
+               for count, seed in zip(frames, args.seeds, strict=True)]
     cached = [cached_track(s, Path(str(CACHE).format(
         seed=f"{seed}{suffix}{f'_warped{head}' if head else ''}")), args.fresh,
         warped_head(head) if head else None)

@@ -38,7 +38,7 @@ class FapAgreement:
     """One FAP's agreement over pooled clips.
 
     fap: FAP id; spread: the true curves' standard deviation (FAP units, clip means out);
-    wobble: the still head's recovered standard deviation (FAP units); judged: ``"correlation"``
+    wobble: the still face's error standard deviation (FAP units); judged: ``"correlation"``
     where ``spread >= ratio * wobble``, else ``"error"``; correlation, low, high: Pearson's r
     and its 95 % interval; samples: effective independent samples; gain: least-squares slope
     of recovered on true; error: root-mean-square error (FAP units, clip means out);
@@ -110,8 +110,9 @@ def agreement(truths: Sequence[np.ndarray], founds: Sequence[np.ndarray],
               ratio: float = SPREAD_RATIO) -> list[FapAgreement]:
     """Each FAP of ``faps`` judged over the pooled clips: ``truths`` and ``founds`` are one
     ``(n_i, 84)`` true and recovered array per clip (same shapes pairwise), ``wobble`` the
-    ``(84,)`` standard deviations recovered on a still face with the clips' head motion (FAP
-    units). ParameterError when the clips do not pair up."""
+    ``(84,)`` standard deviations of the error (recovered minus true) on a still face with
+    the clips' head motion (FAP units: for the face FAPs what is read where nothing moves,
+    for the head's what the pose misses). ParameterError when the clips do not pair up."""
     if len(truths) != len(founds) or not truths:
         raise ParameterError(f"give one recovered array per true one, got {len(truths)} and "
                              f"{len(founds)}")
