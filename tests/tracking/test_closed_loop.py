@@ -113,8 +113,9 @@ lower lids' own pushes to +-350 units): a regression left for the next round."""
 def test_soma_head_follows_the_truth(soma_loop):
     found = {fap_id: round(soma_loop.correlation(fap_id), 3) for fap_id in SOMA_FLOORS}
     assert all(found[k] > v for k, v in SOMA_FLOORS.items()), found
-    seen = {k: round(open_lid_correlation(soma_loop, k), 3) for k in OPEN_LID_FLOORS}
-    assert all(seen[k] > v for k, v in OPEN_LID_FLOORS.items()), seen
+    floors = OPEN_LID_FLOORS | {21: 0.72, 22: 0.78}  # 0.78/0.84 (see SOMA_FLOORS)
+    seen = {k: round(open_lid_correlation(soma_loop, k), 3) for k in floors}
+    assert all(seen[k] > v for k, v in floors.items()), seen
     assert soma_loop.correlation(49) > 0.95
     for fap_id in (19, 20):
         events = closure_events(soma_loop.truth.values[:, fap_id - 1], 600)
