@@ -19,6 +19,10 @@ model has seen; the stylised cartoon head with head turns; last
 ``examples/tracking/expressive.fdl`` (speech with surprise, worry, sadness, fear and anger,
 which move the brows visibly, and gaze) with head turns on the default head, as scripted on
 it, and with head turns on the SOMA-X and cartoon heads.
+Then (issue 37) the speed of the whole video path against MediaPipe's own on the same frames
+(CPU time, ``video_speed``) and, per head (default, cartoon, SOMA-X), the probe stream
+(``closedloop.probe_stream``) judged by the spread rule with confidence intervals
+(``probe_report``, :mod:`facelib.tracking.agreement`).
 Lip closures: the p/b/m closures of the truth (its inner-lip gap under 0.1 MNS0 during a
 bilabial viseme of the storyboard) during which the avatar's lips also touch, those after
 and before which they also part again (a closure held across several does not count); the
