@@ -189,13 +189,15 @@ def test_inner_brows_come_back_with_the_image(expressive_loops):
     # measured 0.97/0.98 on the default head and 0.96/0.98 on SOMA-X; from the landmarks
     # alone (no image shifts) 0.81/0.82 and 0.82/0.84. Since issue 32's action-unit
     # expressions move the brows further, the landmarks alone reach 0.95 and the image
-    # shifts 0.98 (default head): the margin is 0.02, not 0.05
+    # shifts 0.98 (default head): the margin was 0.02, not 0.05; since issue 37 trained the
+    # brows to 400 units the landmarks alone read 0.97/0.97 and 0.96/0.94, the image 0.99
+    # (default head and SOMA-X): 0.01
     for loop in expressive_loops:
         plain = loop.remeasure(brows=None).stream.values
         for fap_id in (31, 32):
             assert loop.correlation(fap_id) > 0.9, fap_id
             alone = np.corrcoef(loop.truth.values[:, fap_id - 1], plain[:, fap_id - 1])[0, 1]
-            assert loop.correlation(fap_id) > alone + 0.02, fap_id
+            assert loop.correlation(fap_id) > alone + 0.01, fap_id
 
 
 def test_a_neutral_start_is_kept_as_the_neutral(loop, soma_loop):
