@@ -87,15 +87,17 @@ def _double_sided_look():
 class _InProcess:
     """A FaceRenderer measured in this process."""
 
-    def __init__(self, renderer, vertices: np.ndarray):
-        self.renderer, self.vertices = renderer, vertices
+    def __init__(self, renderer, vertices: np.ndarray, faps: np.ndarray):
+        self.renderer, self.vertices, self.faps = renderer, vertices, faps
         self.mode = renderer.antialias
         renderer.frame(vertices[0])  # warm up: shaders compiled, buffers made
 
     def measure(self, frames: int) -> tuple[float, float]:
+        # each frame with its FAPs, as render() draws it (they deepen the skin's wrinkles)
         start, start_main = time.process_time(), time.thread_time()
         for i in range(frames):
-            self.renderer.frame(self.vertices[i % len(self.vertices)])
+            k = i % len(self.vertices)
+            self.renderer.frame(self.vertices[k], faps=self.faps[k])
         return ((time.process_time() - start) / frames,
                 (time.thread_time() - start_main) / frames)
 
@@ -165,13 +167,37 @@ def _renderers(faces: dict, stream, args, width: int, height: int) -> dict:
                 continue
             r = FaceRenderer(face, width=width, height=height, antialias=args.antialias,
                              **options)
-            out[f"{label}{tag}"] = _InProcess(r, vertices)
+            out[f"{label}{tag}"] = _InProcess(r, vertices, stream.values[: args.frames])
+        if args.shaders_before and label == "default":
+            r = FaceRenderer(face, width=width, height=height, antialias=args.antialias)
+            _serve_shaders(r, Path(args.shaders_before))
+            out[f"{label}, shaders before"] = _InProcess(r, vertices,
+                                                         stream.values[: args.frames])
         samples = 0 if out[label].mode == "off" else 4
         try:
             out[f"{label}: ceiling"] = _Child(label, args, samples, out[label].renderer)
         except RuntimeError as exc:
             print(f"no ceiling for {label}: {exc}")
     return out
+
+
+def _serve_shaders(renderer, folder: Path) -> None:
+    """Make ``renderer`` (a FaceRenderer) draw with ``folder``'s face.vert and face.frag
+    (an earlier version of facelib's shaders: ``git show main:facelib/data/shaders/...``),
+    everything else the same, so a shader change is measured side by side in one process."""
+    cache = renderer._renderer._renderer._program_cache
+    served = cache.get_program
+
+    def get_program(vertex_shader, fragment_shader, geometry_shader=None, defines=None):
+        if (vertex_shader, fragment_shader, geometry_shader) == ("mesh.vert", "mesh.frag",
+                                                                 None):
+            defines = dict(defines or {})
+            defines.update({k.upper(): float(v) for k, v in renderer.look.shading.items()})
+            vertex_shader = str(folder / "face.vert")
+            fragment_shader = str(folder / "face.frag")
+        return served(vertex_shader, fragment_shader, geometry_shader, defines)
+
+    cache.get_program = get_program
 
 
 def _side_by_side(renderers: dict, rounds: int, frames: int) -> dict:
@@ -221,6 +247,9 @@ def main() -> None:
     parser.add_argument("--antialias", default="auto",
                         choices=["auto", "msaa", "supersample", "off"])
     parser.add_argument("--images", default=None, help="write each renderer's first frame here")
+    parser.add_argument("--shaders-before", default=None,
+                        help="a folder with earlier face.vert/face.frag: also measure the "
+                             "default character drawn with them, side by side")
     args = parser.parse_args()
     if args.platform:
         os.environ["PYOPENGL_PLATFORM"] = args.platform

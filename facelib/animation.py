@@ -5,14 +5,14 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
 
-from facelib import expressions, gaze, visemes
+from facelib import data, expressions, gaze, visemes
 from facelib.checks import check_seed
 from facelib.cues import MAX_FRAMES, Storyboard
 from facelib.errors import FacelibError, ParameterError
@@ -22,11 +22,14 @@ from facelib.gaze.events import GazeEvent
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.track import FapTrack
 from facelib.progress import ProgressCallback, progress_callback
+from facelib.speech.mix import Voice, mix_voices
 from facelib.sync import Liveliness, SyncRules, combine
 from facelib.visemes.animate import SpeechAudio, VisemeAnimation
 from facelib.visemes.timeline import VisemeSpan
+from facelib.visemes.turns import join_turns
 
-__all__ = ["Animation", "animate", "compose", "definition_line", "run_fdl", "speech_track"]
+__all__ = ["Animation", "Scene", "animate", "animate_scene", "compose", "definition_line",
+           "run_fdl", "run_scene", "speech_track"]
 
 
 @dataclass(frozen=True)
@@ -68,6 +71,38 @@ class Animation:
                 f"expressions={len(self.storyboard.expressions)}, "
                 f"gaze={len(self.storyboard.gaze)}, gaze_events={len(self.gaze_events)}"
                 f"{audio})")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A storyboard with characters turned into FAPs: one :class:`Animation` per character.
+
+    storyboard: the storyboard (its ``characters`` and ``camera`` cuts).
+    parts: character name -> its Animation, left to right as the two-shot shows them;
+        every stream has the same number of frames at the storyboard's fps.
+    speech_audio: every character's speech mixed into one soundtrack from time 0
+        (``.samples``, ``.sample_rate``), or None when nobody speaks.
+    """
+
+    storyboard: Storyboard
+    parts: Mapping[str, Animation]
+    speech_audio: SpeechAudio | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "parts", MappingProxyType(dict(self.parts)))
+
+    @property
+    def n_frames(self) -> int:
+        return next(iter(self.parts.values())).faps.n_frames
+
+    @property
+    def fps(self) -> float:
+        return self.storyboard.fps
+
+    def __repr__(self) -> str:
+        source = self.storyboard.path.name if self.storyboard.path else "<storyboard>"
+        return (f"Scene({source!r}, characters={list(self.parts)}, frames={self.n_frames}, "
+                f"fps={self.fps:g}, cuts={len(self.storyboard.camera)})")
 
 
 _STAGES = 4  # speech, expressions, gaze, synchronizer: the units of animate's progress
@@ -112,9 +147,22 @@ def _animate(
         if report is not None:
             report(done, _STAGES)
 
+    if storyboard.characters:
+        names = ", ".join(c.name for c in storyboard.characters)
+        raise ParameterError(f"storyboard {storyboard.path or '(in memory)'} names characters "
+                             f"({names}): animate it with facelib.animate_scene")
     if seed is not None:
         storyboard = replace(storyboard, seed=check_seed(seed))
     rules = rules or SyncRules.load()
+    speech, n_frames = _speech(storyboard, max_frames=max_frames)
+    step(1)
+    return _animation(storyboard, speech, n_frames=n_frames, rules=rules,
+                      report=lambda done: step(1 + done), liveliness=liveliness)
+
+
+def _speech(storyboard: Storyboard, *, max_frames: int) -> tuple[VisemeAnimation | None, int]:
+    """The speech generator's animation of ``storyboard`` (None without speech) and the
+    number of frames it needs: one past the last cue's end, or the speech's length."""
     fps = storyboard.fps
     # one frame past the last cue's end, so the face is shown settling back to neutral
     n_frames = math.floor(storyboard.cues_end_ms * fps / 1000 + 1e-9) + 1
@@ -123,20 +171,28 @@ def _animate(
             f"storyboard {storyboard.path or '(in memory)'} lasts {storyboard.cues_end_ms} ms "
             f"= {n_frames} frames at {fps:g} fps, more than max_frames={max_frames}"
         )
-    speech = (visemes.animate(storyboard.speech, fps=fps, max_frames=max_frames,
-                              language=storyboard.language)
-              if storyboard.speech else None)
+    said = [s for s in (storyboard.speech, *storyboard.turns) if s is not None]
+    turns = [(s, visemes.animate(s, fps=fps, max_frames=max_frames,
+                                 language=storyboard.language)) for s in said]
+    speech = None if not turns else turns[0][1] if len(turns) == 1 else join_turns(turns)
     if speech is not None:
         n_frames = max(n_frames, speech.track.n_frames)
+    return speech, n_frames
+
+
+def _animation(
+    storyboard: Storyboard, speech: VisemeAnimation | None, *, n_frames: int,
+    rules: SyncRules, report: Callable[[int], None] | None, liveliness: Liveliness | None,
+) -> Animation:
+    """The Animation of ``storyboard`` over ``n_frames`` frames with its ``speech``."""
     viseme_track = None if speech is None else speech_track(speech, rules)
-    step(1)
     stream, tracks, eyes = compose(
         storyboard, visemes=viseme_track,
         speaking=None if speech is None else speech.speaking, n_frames=n_frames, rules=rules,
-        report=lambda done: step(1 + done), liveliness=liveliness)
+        report=report, liveliness=liveliness)
     return Animation(
-        faps=stream,
-        audio=storyboard.speech.audio if storyboard.speech else None,
+        faps=stream,  # several turns: their sound is mixed into speech_audio
+        audio=storyboard.speech.audio if storyboard.speech and not storyboard.turns else None,
         storyboard=storyboard,
         audio_offset=storyboard.speech.start_ms / 1000 if storyboard.speech else 0.0,
         tracks=tracks,
@@ -145,6 +201,88 @@ def _animate(
         speech_audio=None if speech is None else speech.audio,
         loudness=None if speech is None else speech.loudness,
     )
+
+
+def animate_scene(
+    storyboard: Storyboard, *, seed: int | None = None, rules: SyncRules | None = None,
+    max_frames: int = MAX_FRAMES, progress: bool | ProgressCallback | None = None,
+    liveliness: Liveliness | None = None,
+) -> Scene:
+    """Animate each character of a storyboard with ``characters { ... }`` as :func:`animate`
+    does a storyboard of one face, all over the same frames (the longest part's), each one's
+    mutual gaze turned toward the others (``facelib/data/alive/dialogue.json``) unless the
+    storyboard defines its own ``default`` eye behaviour, and mix their speech into one
+    soundtrack. ``seed`` overrides the storyboard's (character ``i`` takes ``seed + i``);
+    ``progress`` is called as ``progress(done, 4 * n_characters)``; the other options as for
+    :func:`animate`."""
+    try:
+        return _animate_scene(storyboard, seed=seed, rules=rules or SyncRules.load(),
+                              max_frames=max_frames, liveliness=liveliness,
+                              report=progress_callback(progress, "animating", unit="stages"))
+    except FacelibError as exc:
+        if exc.path is not None or storyboard.path is None:
+            raise
+        raise type(exc)(exc.message, path=storyboard.path,
+                        line=definition_line(storyboard.path, exc.message)) from exc
+
+
+def _animate_scene(
+    storyboard: Storyboard, *, seed: int | None, rules: SyncRules, max_frames: int,
+    liveliness: Liveliness | None, report: ProgressCallback | None,
+) -> Scene:
+    cast = storyboard.characters
+    if not cast:
+        raise ParameterError(f"storyboard {storyboard.path or '(in memory)'} names no "
+                             "characters: animate it with facelib.animate")
+    total = _STAGES * len(cast)
+    parts = [_facing(c.part, index, len(cast), seed=seed) for index, c in enumerate(cast)]
+    speeches = []
+    for index, part in enumerate(parts):
+        speeches.append(_speech(part, max_frames=max_frames))
+        if report is not None:
+            report(index + 1, total)
+    n_frames = max(n for _, n in speeches)
+    animations = {}
+    for index, (character, part, (speech, _)) in enumerate(zip(cast, parts, speeches,
+                                                                strict=True)):
+        done = len(cast) + 3 * index
+
+        def step(k: int, done: int = done) -> None:
+            if report is not None:
+                report(done + k, total)
+
+        animations[character.name] = _animation(part, speech, n_frames=n_frames, rules=rules,
+                                                report=step, liveliness=liveliness)
+    return Scene(storyboard, animations, speech_audio=_soundtrack(animations.values()))
+
+
+def _facing(part: Storyboard, index: int, count: int, *, seed: int | None) -> Storyboard:
+    """Character ``index`` of ``count`` (left to right) with its mutual gaze turned toward
+    the others and the seed ``seed + index`` when ``seed`` is given."""
+    if seed is not None:
+        part = replace(part, seed=(check_seed(seed) + index) % 2**63)
+    if "default" in part.gaze_defs:
+        return part
+    rule = data.json_data("alive/dialogue.json")
+    side = float(np.sign((count - 1) / 2 - index))  # left of centre: +1 (looks to its left)
+    toward = {"gaze_offset_deg": (side * rule["partner_gaze_deg"], 0.0),
+              "head_offset_deg": (side * rule["partner_head_deg"], 0.0)}
+    return replace(part, gaze_defs={**part.gaze_defs, "default": toward})
+
+
+def _soundtrack(animations: Iterable[Animation]) -> SpeechAudio | None:
+    """Every animation's speech (recording or synthesized) mixed from time 0."""
+    voices = []
+    for anim in animations:
+        if anim.audio is not None:
+            voices.append(Voice(anim.audio_offset, file=anim.audio))
+        elif anim.speech_audio is not None:
+            voices.append(Voice(anim.audio_offset, samples=anim.speech_audio.samples,
+                                sample_rate=anim.speech_audio.sample_rate))
+    if not voices:
+        return None
+    samples, rate = mix_voices(voices)
+    return SpeechAudio(samples, rate)
 
 
 def _expression_track(storyboard: Storyboard, n_frames: int,
@@ -234,6 +372,13 @@ def run_fdl(path: str | os.PathLike[str], *, seed: int | None = None,
     """Load the storyboard at ``path`` and animate it (see :func:`animate`; ``progress``
     is called after each of animate's four stages)."""
     return animate(load(Path(path), seed=seed), seed=seed, progress=progress)
+
+
+def run_scene(path: str | os.PathLike[str], *, seed: int | None = None,
+              progress: bool | ProgressCallback | None = None) -> Scene:
+    """Load the storyboard with characters at ``path`` and animate it (see
+    :func:`animate_scene`)."""
+    return animate_scene(load(Path(path), seed=seed), seed=seed, progress=progress)
 
 
 def definition_line(path: str | os.PathLike[str], message: str) -> int | None:

@@ -36,10 +36,14 @@ __all__ = [
     "CameraMove",
     "Clip",
     "Deformable",
+    "SceneClip",
+    "Shot",
     "Speech",
     "check_hair",
     "face_for",
+    "is_scene",
     "make_clip",
+    "make_scene_clip",
     "resolve_face",
     "styled_face",
 ]
@@ -283,3 +287,106 @@ def _from_source(source: object, *, storyboard_face: bool, storyboard_hair: bool
                 audio=None if own is None else Path(own), speech=speech,
                 audio_offset=float(getattr(source, "audio_offset", 0.0) or 0.0),
                 camera=camera)
+
+
+TWO_SHOT = "two_shot"
+"""The framing of a shot that shows every character of a scene side by side (the
+storyboard layer's :data:`facelib.cues.TWO_SHOT`)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Shot:
+    """A cut of a scene at ``start_ms``: to the character ``who`` framed by ``framing``
+    (a look's framing name; None: the render's), or with ``who`` None to the two-shot.
+    ``origin``: the camera cue's storyboard ``(file, line)``, or None."""
+
+    who: str | None
+    start_ms: int
+    framing: str | None = None
+    origin: tuple[str | None, int | None] | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class SceneClip:
+    """What an output of a storyboard with characters plays.
+
+    names: the characters, left to right as the two-shot shows them.
+    clips: each character's :class:`Clip` (its stream, its face wearing its hair, its own
+        speech), in the order of ``names``; every stream has the same frames.
+    shots: the camera's cuts, by start (before the first: the two-shot).
+    speech: every character's speech mixed into one soundtrack from time 0, or None.
+    """
+
+    names: tuple[str, ...]
+    clips: tuple[Clip, ...]
+    shots: tuple[Shot, ...] = ()
+    speech: Speech | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "names", tuple(self.names))
+        object.__setattr__(self, "clips", tuple(self.clips))
+        object.__setattr__(self, "shots", tuple(sorted(self.shots, key=lambda s: s.start_ms)))
+        if not self.clips or len(self.names) != len(self.clips):
+            raise ParameterError(f"a scene needs one clip per character; got "
+                                 f"{len(self.names)} names and {len(self.clips)} clips")
+        frames = {(c.n_frames, c.fps) for c in self.clips}
+        if len(frames) != 1:
+            raise ParameterError(f"a scene's clips must have the same frames and fps; got "
+                                 f"{sorted(frames)}")
+        for shot in self.shots:
+            if shot.who is not None and shot.who not in self.names:
+                raise ParameterError(f"shot of {shot.who!r}: not one of the characters "
+                                     f"({', '.join(self.names)})"
+                                     f"{did_you_mean(shot.who, self.names)}")
+
+    @property
+    def fps(self) -> float:
+        return self.clips[0].fps
+
+    @property
+    def n_frames(self) -> int:
+        return self.clips[0].n_frames
+
+    def clip_of(self, name: str) -> Clip:
+        """The clip of character ``name``."""
+        if name not in self.names:
+            raise ParameterError(f"no character {name!r} in the scene ({', '.join(self.names)})"
+                                 f"{did_you_mean(name, self.names)}")
+        return self.clips[self.names.index(name)]
+
+    def shot_per_frame(self) -> np.ndarray:
+        """``(n_frames,) int``: which shot each frame shows, ``-1`` for the two-shot before
+        the first cut, else the index into ``shots``."""
+        times = np.arange(self.n_frames) * 1000.0 / self.fps
+        starts = np.array([s.start_ms for s in self.shots], np.float64)
+        return np.searchsorted(starts, times + 1e-6, side="right") - 1
+
+
+def is_scene(source: object) -> bool:
+    """Whether ``source`` is a scene (a :class:`SceneClip`, or an animation of a storyboard
+    with characters such as :class:`facelib.Scene`: an object with ``parts``)."""
+    return isinstance(source, SceneClip) or isinstance(getattr(source, "parts", None), Mapping)
+
+
+def make_scene_clip(source: SceneClip | object) -> SceneClip:
+    """The :class:`SceneClip` of ``source``: a SceneClip, or a scene animation (an object
+    with ``parts``, name -> animation, a ``storyboard`` with ``camera`` cuts naming ``who``
+    and ``framing``, and ``speech_audio``, such as :class:`facelib.Scene`). Each part's clip
+    is :func:`make_clip`'s: its storyboard's face wearing its hair."""
+    if isinstance(source, SceneClip):
+        return source
+    parts = getattr(source, "parts", None)
+    if not isinstance(parts, Mapping) or not parts:
+        raise ParameterError(f"a scene output needs a SceneClip or a scene with .parts, not "
+                             f"{type(source).__name__}")
+    storyboard = getattr(source, "storyboard", None)
+    shots = tuple(
+        Shot(None if cue.who is None else str(cue.who), int(cue.start_ms),
+             None if cue.framing in (None, TWO_SHOT) else str(cue.framing),
+             getattr(cue, "origin", None))
+        for cue in (getattr(storyboard, "camera", ()) or ()))
+    samples = getattr(source, "speech_audio", None)
+    speech = (None if samples is None
+              else Speech(np.asarray(samples.samples), int(samples.sample_rate)))
+    return SceneClip(tuple(str(n) for n in parts), tuple(make_clip(a) for a in parts.values()),
+                     shots=shots, speech=speech)

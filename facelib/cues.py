@@ -14,8 +14,8 @@ from types import MappingProxyType
 from typing import Any
 
 __all__ = [
-    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "CameraCue", "ExpressionCue", "GazeCue", "MoodCue",
-    "Origin", "SpeechSpec", "Storyboard", "VisemeCue",
+    "MAX_FRAMES", "MAX_SPEECH_TEXT_CHARS", "TWO_SHOT", "CameraCue", "Character", "ExpressionCue",
+    "GazeCue", "MoodCue", "Origin", "SpeechSpec", "Storyboard", "VisemeCue",
 ]
 
 MAX_FRAMES = 360_000
@@ -26,6 +26,9 @@ MAX_SPEECH_TEXT_CHARS = 100_000
 
 Origin = tuple[str, int]
 """(file, 1-based line) of the script text a cue came from."""
+
+TWO_SHOT = "two_shot"
+"""The camera framing of a storyboard with characters that shows them all side by side."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,12 +88,17 @@ class GazeCue:
 class CameraCue:
     """Re-frame the camera on the named ``framing`` (``"face"``, ``"head"``, ``"bust"``:
     the renderer's framings) at ``start_ms``: a cut when ``duration_ms`` is 0, else a
-    smooth move that arrives ``duration_ms`` later."""
+    smooth move that arrives ``duration_ms`` later.
 
-    framing: str
+    In a storyboard with characters every camera cue is a cut: to the character ``who``
+    (framed by ``framing``, None: the render's framing) or, with ``who`` None and
+    ``framing`` :data:`TWO_SHOT`, to all of them side by side."""
+
+    framing: str | None
     start_ms: int
     duration_ms: int = 0
     origin: Origin | None = None
+    who: str | None = None
 
     @property
     def end_ms(self) -> int:
@@ -136,6 +144,26 @@ class SpeechSpec:
     style: str | float = "normal"
 
 
+@dataclass(frozen=True, slots=True)
+class Character:
+    """A character of a storyboard that names several (``characters { ada = {...} }``).
+
+    name: what cues call it (``who = "ada"``).
+    face: the face definition it is played on, or None (the bundled head); a
+        :func:`facelib.clip.styled_face` definition.
+    hair: the hair style it wears, or None (the face definition's own).
+    part: its own one-character storyboard: its speech, expressions, eye behaviours and
+        moods, the shared definitions, its face and hair, no camera cues.
+    origin: where the storyboard names it.
+    """
+
+    name: str
+    part: Storyboard
+    face: Path | None = None
+    hair: str | None = None
+    origin: Origin | None = None
+
+
 def _frozen_map(value: Mapping[str, Any]) -> Mapping[str, Any]:
     return MappingProxyType(dict(value))
 
@@ -168,6 +196,12 @@ class Storyboard:
         none; None means English.
     camera: the camera cues, in time order (the renderer re-frames at each).
     moods: the mood cues, in time order (each lasts until the next).
+    characters: the characters of a storyboard that names several, left to right as the
+        two-shot shows them (each with its own part, :class:`Character`); then ``speech``,
+        ``expressions``, ``gaze`` and ``moods`` are empty and ``camera`` cuts between them.
+        Empty for a storyboard of one face.
+    turns: what the face says after ``speech``, in time order: the later ``say`` calls of
+        a character (its turns in a dialogue; a storyboard of one face has one ``say``).
     """
 
     path: Path | None = None
@@ -186,6 +220,8 @@ class Storyboard:
     language: str | None = None
     camera: tuple[CameraCue, ...] = ()
     moods: tuple[MoodCue, ...] = ()
+    characters: tuple[Character, ...] = ()
+    turns: tuple[SpeechSpec, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "expression_defs", _frozen_map(self.expression_defs))
@@ -201,6 +237,8 @@ class Storyboard:
         ends = [c.end_ms for c in self.expressions] + [c.end_ms for c in self.gaze]
         ends += [c.start_ms for c in self.moods]
         ends += [c.end_ms for c in self.camera]
-        if self.speech is not None and self.speech.visemes:
-            ends += [c.end_ms for c in self.speech.visemes]
+        ends += [c.part.cues_end_ms for c in self.characters]
+        for said in (self.speech, *self.turns):
+            if said is not None and said.visemes:
+                ends += [c.end_ms for c in said.visemes]
         return max(ends, default=0)

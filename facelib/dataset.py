@@ -430,7 +430,8 @@ def _render_clip(spec: DatasetSpec, draw: ClipDraw, stream: Any, folder: Path,
                         fp: [round(float(x), 3), round(float(y), 3)]
                         for (fp, _), (x, y) in zip(points, pixels, strict=True)}
                     if writer is not None:
-                        writer.write(renderer.frame(frame_vertices))
+                        writer.write(renderer.frame(
+                            frame_vertices, faps=stream.values[start + k]))
         except BaseException:
             if writer is not None:
                 writer.abort()

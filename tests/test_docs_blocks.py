@@ -67,6 +67,9 @@ def test_storyboard_block_checks_and_runs(scratch, where, code, capsys):
         assert main(["check", str(story)]) == 0, capsys.readouterr().err
         assert main(["run", str(story), "-o", str(scratch / "block.fap")]) == 0, (
             capsys.readouterr().err)
+    if "characters {" in code:  # one .fap per character: block.NAME.fap
+        assert sorted(scratch.glob("block.*.fap")), "no .fap per character"
+        return
     assert (scratch / "block.fap").stat().st_size > 0
 
 

@@ -83,3 +83,30 @@ def test_expressive_storyboard_moves_the_brows():
     brow = faps.values[:, fap("raise_l_i_eyebrow").index]
     assert brow.max() > 80 and brow.min() < -5
     assert faps.values[:, fap("open_jaw").index].max() > 300   # it speaks
+
+
+def test_dialogue_storyboard_has_two_characters_speaking_in_turn():
+    pytest.importorskip("espeakng_loader")
+    from facelib import run_scene
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = run_scene(EXAMPLES / "dialogue" / "dialogue.fdl")
+    ada, ben = scene.parts["ada"], scene.parts["ben"]
+    said = {name: [(s.start_ms, s.end_ms) for s in anim.visemes if s.name != "sil"]
+            for name, anim in scene.parts.items()}
+    assert not any(a0 < b1 and b0 < a1 for a0, a1 in said["ada"] for b0, b1 in said["ben"])
+    turns = sorted((s[0], name) for name, spans in said.items() for s in spans)
+    order = [name for i, (_, name) in enumerate(turns) if i == 0 or turns[i - 1][1] != name]
+    assert order == ["ada", "ben", "ada", "ben"]  # they speak in turn
+    jaw = fap("open_jaw").index
+    frames = np.arange(scene.n_frames) * 40
+    for speaker, listener in ((ada, ben), (ben, ada)):
+        talking = np.zeros(scene.n_frames, bool)
+        for span in speaker.visemes:
+            if span.name != "sil":
+                talking |= (frames >= span.start_ms) & (frames < span.end_ms)
+        assert speaker.faps.values[talking, jaw].max() > 300
+        assert np.abs(listener.faps.values[talking, jaw]).max() < 40  # lips only for the speaker
+    assert [c.who for c in scene.storyboard.camera] == ["ben", "ada", None]
+    assert scene.speech_audio.samples.size > 6 * scene.speech_audio.sample_rate

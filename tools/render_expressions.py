@@ -65,7 +65,8 @@ def contactsheet(face: Face, names: list[str], title: str) -> np.ndarray:
         for start in range(0, len(names), COLUMNS):
             chunk = names[start : start + COLUMNS]
             for intensity in (0.6, 1.0):
-                row = [label(renderer.frame(face.deform_frame(pose(n, intensity))),
+                row = [label(renderer.frame(face.deform_frame(pose(n, intensity)),
+                                             faps=pose(n, intensity)),
                               f"{title}: {n} {intensity:g}") for n in chunk]
                 cells += row + [np.zeros_like(row[0])] * (COLUMNS - len(row))
     return sheet(cells, COLUMNS)
@@ -79,7 +80,8 @@ def reviewsheet(face: Face, names: list[str], folder: Path) -> None:
     order = list(names)
     np.random.default_rng(REVIEW_SEED).shuffle(order)
     with FaceRenderer(face, width=300, height=360) as renderer:
-        pictures = [label(renderer.frame(face.deform_frame(pose(n, 0.6))), str(i + 1))
+        pictures = [label(renderer.frame(face.deform_frame(pose(n, 0.6)), faps=pose(n, 0.6)),
+                              str(i + 1))
                     for i, n in enumerate(order)]
     folder.mkdir(parents=True, exist_ok=True)
     save_png(sheet(pictures, 4), folder / "expressions_review.png")

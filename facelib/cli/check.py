@@ -21,20 +21,27 @@ def add(commands: Any) -> None:
 
 
 def _check(args: argparse.Namespace, console: Console) -> int:
-    from facelib.animation import animate
+    from facelib.animation import animate, animate_scene
+    from facelib.clip import check_hair
     from facelib.fdl import describe, load
 
     storyboard = load(args.story, seed=args.seed)
-    if storyboard.hair is not None:  # render would refuse it when it loads the face
-        from facelib.clip import check_hair
-
-        check_hair(storyboard.face, storyboard.hair, path=args.story,
-                   line=storyboard.setting_lines.get("hair"))
-    animation = animate(storyboard, seed=args.seed)  # what run rejects, check rejects
+    parts = [c.part for c in storyboard.characters] or [storyboard]
+    for part in parts:
+        if part.hair is not None:  # render would refuse it when it loads the face
+            check_hair(part.face, part.hair, path=args.story,
+                       line=part.setting_lines.get("hair"))
+    # what run rejects, check rejects
+    if storyboard.characters:
+        faps = next(iter(animate_scene(storyboard, seed=args.seed).parts.values())).faps
+    else:
+        faps = animate(storyboard, seed=args.seed).faps
     print(describe(storyboard))
-    target = default_output(args.story, storyboard.output, ".fap")
-    console.status(f"ok: {animation.faps.n_frames} frames at {animation.faps.fps:g} fps "
-                   f"({animation.faps.duration:.2f} s); 'facelib run' without -o writes "
+    target = str(default_output(args.story, storyboard.output, ".fap"))
+    if storyboard.characters:
+        names = ", ".join(c.name for c in storyboard.characters)
+        target += f" as one file per character ({names})"
+    console.status(f"ok: {faps.n_frames} frames at {faps.fps:g} fps "
+                   f"({faps.duration:.2f} s); 'facelib run' without -o writes "
                    f"{target}")
     return EXIT_OK
-

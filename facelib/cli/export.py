@@ -1,5 +1,5 @@
-"""``facelib export SOURCE``: glTF (.glb), ARKit curves (.csv/.json), a VRM avatar (.vrm) or a
-web page."""
+"""``facelib export SOURCE``: glTF (.glb), ARKit curves (.csv/.json), a VRM avatar (.vrm), a
+VRM animation (.vrma) or a web page."""
 
 from __future__ import annotations
 
@@ -15,10 +15,11 @@ from facelib.cli.outputs import check_suffix
 def add(commands: Any) -> None:
     export = commands.add_parser(
         "export", parents=[COMMON],
-        help="export to glTF (.glb), ARKit curves (.csv/.json) or a web page")
+        help="export to glTF (.glb), ARKit curves (.csv/.json), VRM (.vrm, .vrma) or a web page")
     export.add_argument("source", help="STORY.fdl or FILE.fap")
     export.add_argument("-o", "--output",
-                        help="OUT.glb (glTF), or with --arkit OUT.csv (Live Link Face) / OUT.json")
+                        help="OUT.glb (glTF), OUT.vrma (a VRM 1.0 animation for any VRM avatar), "
+                             "or with --arkit OUT.csv (Live Link Face) / OUT.json")
     export.add_argument("--arkit", action="store_true",
                         help="write ARKit-52 blendshape curves instead of glTF")
     export.add_argument("--targets", choices=("fap", "arkit"), default="fap",
@@ -41,13 +42,13 @@ def _export(args: argparse.Namespace, console: Console) -> int:
     from facelib import export
 
     if args.output is None and args.html is None and args.vrm is None:
-        raise UsageError("give -o OUT.glb (or OUT.csv / OUT.json with --arkit), --html DIR, "
-                         "--vrm OUT.vrm, or several")
+        raise UsageError("give -o OUT.glb (or OUT.vrma, or OUT.csv / OUT.json with --arkit), "
+                         "--html DIR, --vrm OUT.vrm, or several")
     if args.vrm is not None:
         check_suffix(args.vrm, (".vrm",), "export --vrm")
     if args.output is not None:
         check_suffix(args.output, (".csv", ".json") if args.arkit else
-                     (".glb", ".csv", ".json"), "export")
+                     (".glb", ".vrma", ".csv", ".json"), "export")
     face = output_face(args, None)  # exports ignore a storyboard's face, not its hair
     if face is not None and not hasattr(face, "vertices"):
         from facelib.engine import load_face
@@ -63,6 +64,10 @@ def _export(args: argparse.Namespace, console: Console) -> int:
                    f"median relative {float(np.median(moving)):.2f}" if moving.size else "")
             console.status(f"wrote {args.output} ({curves.n_frames} frames of 52 ARKit "
                            f"weights{fit})")
+        elif suffix == ".vrma":
+            motion = export.export_vrma(source, args.output)
+            console.status(f"wrote {motion.path} (VRM animation: {motion.n_frames} frames of "
+                           f"{len(motion.presets)} expressions, head and look-at)")
         else:
             result = export.export_gltf(source, args.output, face=face, audio=args.audio,
                                         targets=args.targets)

@@ -54,12 +54,28 @@ def chosen_face(face: str | None) -> Any:
     return default_face() if path is None else load_face(path)
 
 
-def read_source(path: str, seed: int | None, console: Console) -> Any:
-    """A storyboard's Animation, or a .fap file's stream."""
+def read_source(path: str, seed: int | None, console: Console, *, scenes: bool = False) -> Any:
+    """A storyboard's Animation, or a .fap file's stream; with ``scenes``, a storyboard with
+    characters gives its Scene (else UsageError: the command plays one face)."""
     if Path(path).suffix.lower() == ".fap":
         return read_fap(path)
-    from facelib.animation import run_fdl
+    from facelib.animation import animate, animate_scene
+    from facelib.fdl import load
 
-    return run_fdl(path, seed=seed,
-                   progress=console.progress("animating", unit="stages", show=console.verbose))
+    storyboard = load(Path(path), seed=seed)
+    progress = console.progress("animating", unit="stages", show=console.verbose)
+    if storyboard.characters:
+        if not scenes:
+            names = ", ".join(c.name for c in storyboard.characters)
+            raise UsageError(f"{path} names characters ({names}); `facelib render` and "
+                             "`facelib run` play storyboards with characters, this command "
+                             "plays one face")
+        return animate_scene(storyboard, seed=seed, progress=progress)
+    return animate(storyboard, seed=seed, progress=progress)
 
+
+def character_file(path: str | Path, name: str) -> Path:
+    """The file of character ``name`` for an output ``path`` of a storyboard with
+    characters: ``out/dialogue.fap`` -> ``out/dialogue.ada.fap``."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.{name}{path.suffix}")

@@ -10,8 +10,16 @@ from pathlib import Path
 from typing import Any
 
 from facelib.cli.console import EXIT_ERROR, EXIT_OK, Console, UsageError
-from facelib.cli.options import COMMON, add_hair, face_path, output_face, read_source
+from facelib.cli.options import (
+    COMMON,
+    add_hair,
+    character_file,
+    face_path,
+    output_face,
+    read_source,
+)
 from facelib.cli.outputs import RENDER_SUFFIXES, check_suffix, default_output
+from facelib.clip import is_scene
 from facelib.mpeg4 import FapStream, write_fap_complete
 
 
@@ -55,7 +63,9 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
     from facelib.rendering.frames import render
 
     started = time.perf_counter()
-    source = read_source(source_path, args.seed, console)
+    source = read_source(source_path, args.seed, console, scenes=True)
+    if is_scene(source):
+        return _render_scene(source, out, args, console, started)
     if args.fap is not None:
         check_suffix(args.fap, (".fap",), "--fap")
         stream = source if isinstance(source, FapStream) else source.faps
@@ -66,6 +76,31 @@ def _render_one(source_path: str, out: str, args: argparse.Namespace, console: C
                      framing=args.framing,
                      height=args.height, audio=args.audio, fps=args.fps,
                      progress=console.progress("rendering"))
+    console.status(f"wrote {written} in {time.perf_counter() - started:.1f} s")
+    return EXIT_OK
+
+
+def _render_scene(scene: Any, out: str, args: argparse.Namespace, console: Console,
+                  started: float) -> int:
+    """A storyboard with characters: one .fap per character (``--fap out/x.fap`` writes
+    ``out/x.ada.fap``, ...) and the video cutting between them."""
+    from facelib.rendering.shots import render_scene
+
+    for option in ("face", "hair"):
+        if getattr(args, option) is not None:
+            raise UsageError(f"--{option}: the storyboard names characters; give each one's "
+                             f"{option} in characters {{ ... }}")
+    if args.fap is not None:
+        check_suffix(args.fap, (".fap",), "--fap")
+        for name, animation in scene.parts.items():
+            written_faps = write_fap_complete(animation.faps, character_file(args.fap, name))
+            console.status(f"wrote {' and '.join(map(str, written_faps))} ({name}, "
+                           f"{animation.faps.n_frames} frames)")
+    if args.fps is not None or args.audio is not None:
+        raise UsageError("--fps and --audio are for one face; a storyboard with characters "
+                         "plays at its own fps with its own speech")
+    written = render_scene(scene, out=out, width=args.width, height=args.height,
+                           framing=args.framing, progress=console.progress("rendering"))
     console.status(f"wrote {written} in {time.perf_counter() - started:.1f} s")
     return EXIT_OK
 

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from facelib.cli.console import EXIT_OK, Console
+from facelib.cli.console import EXIT_OK, Console, UsageError
 from facelib.cli.options import COMMON
 from facelib.cli.outputs import STDOUT, check_suffix, default_output, emit_text
 from facelib.mpeg4 import format_fap
@@ -25,17 +25,26 @@ def add(commands: Any) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from facelib.animation import run_fdl
+    from facelib.cli.options import character_file, read_source
 
     if args.output is not None:
         check_suffix(args.output, (".fap",), "run")
-    animation = run_fdl(args.story, seed=args.seed,
-                        progress=console.progress("animating", unit="stages", show=False))
+    animation = read_source(args.story, args.seed, console, scenes=True)
     out = args.output or str(default_output(args.story, animation.storyboard.output, ".fap"))
     check_suffix(out, (".fap",), "run")
-    stream = animation.faps
+    parts = getattr(animation, "parts", None)
+    if parts is None:
+        return _emit(animation.faps, out, args, console)
+    if out == STDOUT:
+        raise UsageError("the storyboard names characters: one .fap per character is written "
+                         "(-o OUT.fap writes OUT.NAME.fap), not to stdout")
+    for name, part in parts.items():
+        _emit(part.faps, str(character_file(out, name)), args, console)
+    return EXIT_OK
+
+
+def _emit(stream: Any, out: str, args: argparse.Namespace, console: Console) -> int:
     name = Path(args.story).stem if out == STDOUT else Path(out).stem
     emit_text(format_fap(stream, dialect=args.dialect, name=name), out, console,
               f"({stream.n_frames} frames, {stream.duration:.2f} s)")
     return EXIT_OK
-

@@ -1,5 +1,6 @@
-"""Exports into other tools: glTF 2.0 with morph targets and a skin, VRM 1.0 avatars,
-ARKit-52 blendshape curves (Live Link Face CSV, JSON) and their import, and a static web player.
+"""Exports into other tools: glTF 2.0 with morph targets and a skin, VRM 1.0 avatars and
+animations, ARKit-52 blendshape curves (Live Link Face CSV, JSON) and their import, and a
+static web player.
 
 Loaded on first use (``facelib.export_gltf`` ...); the glTF container needs the ``export``
 extra (pygltflib), the web player the npm build (``make web``).
@@ -24,14 +25,14 @@ from facelib.export.livelink import (
     write_live_link_csv,
 )
 from facelib.export.vrm import VrmExport, export_vrm
+from facelib.export.vrma import VrmaExport, export_vrma
 from facelib.export.web import WebExport, export_html
 
 __all__ = [
-    "ANGLE_NAMES", "ArkitCurves", "GltfExport", "RegionResidual", "VrmExport", "WebExport",
-    "arkit_names",
-    "arkit_residuals", "export_arkit",
-    "export_gltf", "export_html", "export_vrm", "from_arkit", "import_arkit", "live_link_names",
-    "read_arkit_json",
+    "ANGLE_NAMES", "ArkitCurves", "GltfExport", "RegionResidual", "VrmExport", "VrmaExport",
+    "WebExport",
+    "arkit_names", "arkit_residuals", "export_arkit", "export_gltf", "export_html", "export_vrm",
+    "export_vrma", "from_arkit", "import_arkit", "live_link_names", "read_arkit_json",
     "read_live_link_csv", "to_arkit", "write_arkit_json", "write_live_link_csv",
 ]
 

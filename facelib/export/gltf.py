@@ -1,6 +1,8 @@
-"""glTF 2.0 export: the head with its vertex colours (the baked ambient occlusion multiplied
-in, as facelib's renderer does), sparse morph targets for the engine's
-linear basis, a skin for eyes, eyelids, jaw and head, and an animation of a FapStream.
+"""glTF 2.0 export: the head as one mesh and one node per part (skin, eyes, teeth, tongue,
+lashes, bust, garment, hair; each node named for its part) with its vertex colours (the baked
+ambient occlusion multiplied in, as facelib's renderer does), sparse morph targets for the
+engine's linear basis (the same list on every part), one skin for eyes, eyelids, jaw and head
+that all parts share, and an animation of a FapStream.
 
 The container is built with pygltflib (``export`` extra). A frame of the animation evaluated
 as glTF specifies (morph targets, then linear blend skinning) gives ``Face.deform`` of that
@@ -47,8 +49,10 @@ class GltfExport:
         negative target). Every animated weight is in [0, 1] (Blender clamps to that).
         With ``targets="arkit"``: ``targets`` is empty and ``scales`` all ones (52).
     n_frames, fps: the animation's frames (one keyframe per frame) and rate.
-    names: (T,) each target's name (``mesh.extras.targetNames``): ``fap4_lower_t_midlip``,
-        ``fap4_lower_t_midlip_neg`` ..., or the 52 ARKit names ``eyeBlinkLeft`` ...
+    names: (T,) each target's name (every part mesh's ``extras.targetNames``):
+        ``fap4_lower_t_midlip``, ``fap4_lower_t_midlip_neg`` ..., or the 52 ARKit names
+        ``eyeBlinkLeft`` ...
+    parts: the part names, which are the mesh nodes' (and meshes') names, in node order.
     """
 
     path: Path
@@ -58,6 +62,7 @@ class GltfExport:
     n_frames: int
     fps: float
     names: tuple[str, ...] = ()
+    parts: tuple[str, ...] = ()
 
 
 class _Builder:
@@ -188,7 +193,9 @@ def primitive_vertex_ids(part: Part) -> np.ndarray:
 
 
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
-    """One primitive per part; ``targets`` (T, V, 3) float32 displacements."""
+    """One primitive per part, in part order; ``targets`` (T, V, 3) float32 displacements
+    (every primitive holds all T, sparse: a target that moves none of a part's vertices is
+    an accessor of zeros without data)."""
     lib = b.lib
     look_data = data.json_data("render_look.json")
     look = look_data["parts"]
@@ -232,6 +239,32 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     return out
 
 
+# _FIRST_ROOT: the node above the skeleton is the file's first node. Blender's importer
+# (3.4) makes each animated skinned mesh node an empty of the node's name and puts an object
+# of the mesh's name under the armature; it names objects in the order it makes them, roots
+# in node order, so with the armature first the part objects get the parts' names (the
+# empties get ``skin.001`` ...), and three.js, which names each object for its node, the same.
+
+
+def _part_nodes(b: _Builder, face: Face, rig: Rig, targets: np.ndarray,
+                names: tuple[str, ...]) -> list[int]:
+    """One mesh and one node per part, both named for the part (``skin``, ``eye_l``,
+    ``teeth_upper`` ... ``hair``), so that an importer makes one object per part: each mesh
+    has the part's primitive with all T ``targets`` ((T, V, 3) float32) under the same
+    ``names`` (``extras.targetNames``, weights 0), and each node is skinned by skin 0 (the
+    rig's, written after). Returns the nodes' indices in part order."""
+    lib, count, out = b.lib, len(names), []
+    for name, primitive in zip(face.parts, _primitives(b, face, rig, targets), strict=True):
+        mesh = lib.Mesh(name=name, primitives=[primitive],
+                        weights=[0.0] * count if count else None)
+        if count:
+            mesh.extras = {"targetNames": list(names)}
+        b.g.meshes.append(mesh)
+        b.g.nodes.append(lib.Node(name=name, mesh=len(b.g.meshes) - 1, skin=0))
+        out.append(len(b.g.nodes) - 1)
+    return out
+
+
 def _skeleton(b: _Builder, rig: Rig, pose: Pose) -> list[int]:
     """Joint nodes (children linked), their skin, and return the joint node indices."""
     lib = b.lib
@@ -250,29 +283,31 @@ def _skeleton(b: _Builder, rig: Rig, pose: Pose) -> list[int]:
 
 
 def _animation(b: _Builder, joint_nodes: list[int], weights: np.ndarray, pose: Pose, *,
-               fps: float, mesh_node: int = 0) -> None:
-    """One keyframe per frame: morph weights and every joint transform that changes."""
+               fps: float, mesh_nodes: list[int]) -> None:
+    """One keyframe per frame: the morph weights of every part's node (one channel each,
+    all reading one sampler) and every joint transform that changes."""
     lib = b.lib
     n = len(weights)
-    channels: list[tuple[int, str, np.ndarray, str]] = []
+    channels: list[tuple[list[int], str, np.ndarray, str]] = []
     if weights.size:
-        channels.append((mesh_node, "weights", weights.reshape(-1, 1), "SCALAR"))
+        channels.append((mesh_nodes, "weights", weights.reshape(-1, 1), "SCALAR"))
     for j, node in enumerate(joint_nodes):
         for path, values, kind in (("rotation", pose.rotation[:, j], "VEC4"),
                                    ("translation", pose.translation[:, j], "VEC3")):
             if np.ptp(values, axis=0).max() > 0:
-                channels.append((node, path, values, kind))
+                channels.append(([node], path, values, kind))
     if not channels or n < 1:
         return
     times = b.accessor((np.arange(n) / fps).astype(np.float32), "SCALAR", bounds=True)
     animation = lib.Animation(name="facelib", samplers=[], channels=[])
-    for node, path, values, kind in channels:
+    for nodes, path, values, kind in channels:
         animation.samplers.append(lib.AnimationSampler(
             input=times, output=b.accessor(np.ascontiguousarray(values, np.float32), kind),
             interpolation="LINEAR"))
-        animation.channels.append(lib.AnimationChannel(
-            sampler=len(animation.samplers) - 1,
-            target=lib.AnimationChannelTarget(node=node, path=path)))
+        for node in nodes:
+            animation.channels.append(lib.AnimationChannel(
+                sampler=len(animation.samplers) - 1,
+                target=lib.AnimationChannelTarget(node=node, path=path)))
     b.g.animations.append(animation)
 
 
@@ -379,26 +414,24 @@ def export_gltf(
         temp.write_bytes(_container(lib, face, rig, made, stream, copied=copied,
                                     offset=clip.audio_offset))
     return GltfExport(out, copied, tuple(int(r) + 1 for r in made.rows), made.scales,
-                      int(stream.n_frames), float(stream.fps), made.names)
+                      int(stream.n_frames), float(stream.fps), made.names, tuple(face.parts))
 
 
 def _container(lib: Any, face: Face, rig: Rig, made: _Targets, stream: FapStream, *,
                copied: Path | None, offset: float) -> bytes:
-    """The ``.glb`` bytes: the mesh with its targets, the skin and the animation."""
+    """The ``.glb`` bytes: a mesh and node per part with the targets, the skin and the
+    animation."""
     g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
     g.asset.extras = _asset_extras(stream, made.extras, copied, offset)
     b = _Builder(g, lib)
-    count = len(made.names)
-    mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, made.displacements),
-                    weights=[0.0] * count if count else None)
-    if count:
-        mesh.extras = {"targetNames": list(made.names)}
-    g.meshes.append(mesh)
-    g.nodes.append(lib.Node(name="face", mesh=0, skin=0))
+    g.nodes.append(lib.Node(name="face_rig"))  # node 0, the skeleton's parent (_FIRST_ROOT)
+    parts = _part_nodes(b, face, rig, made.displacements, made.names)
     joint_nodes = _skeleton(b, rig, made.pose)
-    g.scenes.append(lib.Scene(name="facelib", nodes=[0, joint_nodes[0]]))
+    g.nodes[0].children = [joint_nodes[0]]
+    g.scenes.append(lib.Scene(name="facelib", nodes=[0, *parts]))
     g.scene = 0
-    _animation(b, joint_nodes, made.weights, made.pose, fps=float(stream.fps))
+    _animation(b, joint_nodes, made.weights, made.pose, fps=float(stream.fps),
+               mesh_nodes=parts)
     blob = b.blob()
     g.buffers.append(lib.Buffer(byteLength=len(blob)))
     g.set_binary_blob(blob)

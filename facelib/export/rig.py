@@ -5,7 +5,8 @@
 
 * every row of the face's compiled linear operator (one basis vector per FAP, whatever
   deformer or learned field made it) becomes a morph target whose weight is the FAP value;
-* eyes, lower teeth and tongue (jaw) are rigid: one joint each, exact;
+* eyes (joints ``eyeball_l``, ``eyeball_r``: the mesh nodes ``eye_l``, ``eye_r`` are the
+  parts') and lower teeth and tongue (``jaw``) are rigid: one joint each, exact;
 * eyelid vertices turn about the eye centre by ``w * angle`` and neck vertices by ``w`` of
   the head rotation, with per-vertex ``w`` in [0, 1]. Linear blend skinning between two joints
   would cut the arc, so each hinge gets ``FRACTIONS`` joints turned by ``k / FRACTIONS`` of
@@ -32,6 +33,9 @@ FRACTIONS = 8
 # each eyelid hinge's joint chain is named for the FAP that drives it (FAP 19-22: close the
 # top left, top right, bottom left, bottom right eyelid; the face's left is +x)
 _LID_NAMES = {19: "lid_upper_l", 20: "lid_upper_r", 21: "lid_lower_l", 22: "lid_lower_r"}
+# each eye part's joint: not the part's own name, which its mesh node has (three.js renames
+# a second node of one name, and a script that looks a name up must find one thing)
+_EYE_JOINTS = {"eye_l": "eyeball_l", "eye_r": "eyeball_r"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -72,8 +76,8 @@ def _fraction_pair(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def build_rig(face: Face) -> Rig:
     """The joints of ``face`` and each vertex's two joints and weights."""
     r = face._rigid  # the engine's precomputed rigid steps (hinges, neck weights)
-    names = ["root"] + [f"neck_{k}" for k in range(1, FRACTIONS)] + ["head", "eye_l", "eye_r",
-                                                                      "jaw"]
+    names = ["root", *(f"neck_{k}" for k in range(1, FRACTIONS)), "head",
+             *_EYE_JOINTS.values(), "jaw"]
     head = len(names) - 4
     parents = [-1] + [0] * (FRACTIONS - 1) + [0, head, head, head]
     rest = [face.pivots["head"]] * (FRACTIONS + 1) + [face.pivots["eye_l"], face.pivots["eye_r"],
@@ -96,7 +100,9 @@ def build_rig(face: Face) -> Rig:
     fraction_joint = np.array([0, *range(1, FRACTIONS), head])
     joints[neck_ids] = np.stack([fraction_joint[low], fraction_joint[low + 1]], 1)
     weights[neck_ids] = np.stack([1 - blend, blend], 1)
-    for name, joint in (("eye_l", head + 1), ("eye_r", head + 2)):
+    # what the head leaves where it is (the bust, the garment): the static root
+    joints[r.still[::3] // 3, 0] = 0
+    for name, joint in zip(_EYE_JOINTS, (head + 1, head + 2), strict=True):
         joints[face.parts[name].vertex_ids, 0] = joint
     jaw_ids = r.jaw_y // 3
     joints[jaw_ids, 0] = head + 3
@@ -145,7 +151,7 @@ def pose_rig(face: Face, rig: Rig, stream: FapStream) -> Pose:
     for k in range(1, FRACTIONS):
         rot[:, k] = Rotation.from_rotvec(rotvec * (k / FRACTIONS)).as_quat()
     for name, yaw, pitch, thrust in (("eye_l", 23, 25, 27), ("eye_r", 24, 26, 28)):
-        j = rig.names.index(name)
+        j = rig.names.index(_EYE_JOINTS[name])
         rot[:, j] = _quaternions(rigid.rotation_matrices(
             f[:, pitch - 1] * au, f[:, yaw - 1] * au, np.zeros(n)))
         trans[:, j, 2] += (f[:, thrust - 1] * face.fapu["ES"]).astype(np.float32)

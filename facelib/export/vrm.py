@@ -4,14 +4,15 @@ extension, specVersion 1.0).
 What the file holds besides the glTF head of :mod:`facelib.export.gltf` (parts, vertex
 colours, the joint skin of eyes, lids, jaw and head):
 
-* one morph target per expression preset (``aa`` ... ``lookRight``,
-  :mod:`facelib.export.vrm_presets`), bound by ``expressions.preset``;
-* a humanoid: the head rig's ``head``, ``eye_l``, ``eye_r`` and ``jaw`` joints as
+* one mesh and node per part (``skin``, ``eye_l`` ... ``hair``), each with one morph target
+  per expression preset (``aa`` ... ``lookRight``, :mod:`facelib.export.vrm_presets`; the
+  same list on every part), bound on every part by ``expressions.preset``;
+* a humanoid: the head rig's ``head``, ``eyeball_l``, ``eyeball_r`` and ``jaw`` joints as
   ``head``, ``leftEye``, ``rightEye`` and ``jaw``, below stand-in body nodes for the bones
   VRM 1.0 requires (hips, spine, chest, neck, legs, arms: ``export/vrm.json``) that no
   vertex follows;
-* ``lookAt`` of type ``bone`` (the eye joints), ``firstPerson`` (the head mesh ``auto``:
-  a viewer hides what follows the head bone), and ``meta``.
+* ``lookAt`` of type ``bone`` (the eye joints), ``firstPerson`` (every part mesh ``auto``:
+  a viewer hides what follows the head bone, so the bust and neck stay), and ``meta``.
 
 VRM lists animations among the glTF items it does not use, so the file holds none: the
 avatar is driven by its expressions (lip sync, blinks, emotions) and look-at.
@@ -30,7 +31,7 @@ from facelib import data
 from facelib.atomic import atomic_path
 from facelib.engine import Face, default_face
 from facelib.errors import ParameterError
-from facelib.export.gltf import _Builder, _import_pygltflib, _primitives, _skeleton
+from facelib.export.gltf import _Builder, _import_pygltflib, _part_nodes, _skeleton
 from facelib.export.rig import Rig, build_rig, pose_rig
 from facelib.export.source import Source, export_clip, face_of
 from facelib.export.vrm_presets import preset_names, preset_targets
@@ -46,12 +47,14 @@ class VrmExport:
     """What :func:`export_vrm` wrote.
 
     path: the ``.vrm``; presets: the expression preset names, in morph-target order (target
-    ``k`` of the mesh is preset ``k`` at weight 1); bones: the humanoid bone names written.
+    ``k`` of each part's mesh is preset ``k`` at weight 1); bones: the humanoid bone names
+    written; parts: the part names, which are the mesh nodes' names, in node order.
     """
 
     path: Path
     presets: tuple[str, ...]
     bones: tuple[str, ...]
+    parts: tuple[str, ...] = ()
 
 
 def _body(b: _Builder, rig: Rig, face: Face, rig_root: int) -> dict[str, int]:
@@ -76,10 +79,11 @@ def _body(b: _Builder, rig: Rig, face: Face, rig_root: int) -> dict[str, int]:
     return nodes
 
 
-def _expressions(names: tuple[str, ...], mesh_node: int) -> dict[str, Any]:
-    """``expressions.preset``: each preset binds its own target at weight 1."""
+def _expressions(names: tuple[str, ...], mesh_nodes: list[int]) -> dict[str, Any]:
+    """``expressions.preset``: each preset binds its own target at weight 1 on every part's
+    mesh node."""
     return {"preset": {name: {
-        "morphTargetBinds": [{"node": mesh_node, "index": k, "weight": 1.0}],
+        "morphTargetBinds": [{"node": node, "index": k, "weight": 1.0} for node in mesh_nodes],
         "isBinary": False, "overrideBlink": "none", "overrideLookAt": "none",
         "overrideMouth": "none"} for k, name in enumerate(names)}}
 
@@ -102,16 +106,18 @@ def _look_at(face: Face) -> dict[str, Any]:
 
 
 def _vrm_extension(face: Face, rig: Rig, nodes: dict[str, int], joint_nodes: list[int], *,
-                   names: tuple[str, ...], meta: dict[str, Any]) -> dict[str, Any]:
+                   mesh_nodes: list[int], names: tuple[str, ...],
+                   meta: dict[str, Any]) -> dict[str, Any]:
     """The ``VRMC_vrm`` object."""
     bones = dict(nodes)
-    for bone, joint in (("head", "head"), ("leftEye", "eye_l"), ("rightEye", "eye_r"),
+    for bone, joint in (("head", "head"), ("leftEye", "eyeball_l"), ("rightEye", "eyeball_r"),
                         ("jaw", "jaw")):
         bones[bone] = joint_nodes[rig.names.index(joint)]
     return {"specVersion": "1.0", "meta": meta,
             "humanoid": {"humanBones": {bone: {"node": n} for bone, n in bones.items()}},
-            "firstPerson": {"meshAnnotations": [{"node": 0, "type": "auto"}]},
-            "lookAt": _look_at(face), "expressions": _expressions(names, 0)}
+            "firstPerson": {"meshAnnotations": [{"node": node, "type": "auto"}
+                                                for node in mesh_nodes]},
+            "lookAt": _look_at(face), "expressions": _expressions(names, mesh_nodes)}
 
 
 def _meta(overrides: dict[str, Any] | None) -> dict[str, Any]:
@@ -153,27 +159,25 @@ def export_vrm(
     with atomic_path(out) as temp:
         temp.write_bytes(_container(lib, face, names, fields))
     bones = tuple(row["bone"] for row in data.json_data(_FILE)["body"])
-    return VrmExport(out, names, (*bones, "head", "leftEye", "rightEye", "jaw"))
+    return VrmExport(out, names, (*bones, "head", "leftEye", "rightEye", "jaw"),
+                     tuple(face.parts))
 
 
 def _container(lib: Any, face: Face, names: tuple[str, ...], meta: dict[str, Any]) -> bytes:
-    """The ``.vrm`` bytes: the mesh with one target per preset, the skin at rest, the body
-    nodes and the extension."""
+    """The ``.vrm`` bytes: a mesh per part with one target per preset, the skin at rest, the
+    body nodes and the extension."""
     rig = build_rig(face)
     g = lib.GLTF2(asset=lib.Asset(generator="facelib", version="2.0"))
     b = _Builder(g, lib)
-    mesh = lib.Mesh(name="face", primitives=_primitives(b, face, rig, preset_targets(face)),
-                    weights=[0.0] * len(names))
-    mesh.extras = {"targetNames": list(names)}
-    g.meshes.append(mesh)
-    g.nodes.append(lib.Node(name="face", mesh=0, skin=0))
+    g.nodes.append(lib.Node(name="vrm_root"))  # node 0, above the body (gltf._FIRST_ROOT)
+    parts = _part_nodes(b, face, rig, preset_targets(face), names)
     joint_nodes = _skeleton(b, rig, pose_rig(face, rig, FapStream.zeros(1, fps=25)))
     nodes = _body(b, rig, face, joint_nodes[0])
-    g.nodes.append(lib.Node(name="vrm_root", children=[nodes["hips"]]))
-    g.scenes.append(lib.Scene(name="facelib", nodes=[0, len(g.nodes) - 1]))
+    g.nodes[0].children = [nodes["hips"]]
+    g.scenes.append(lib.Scene(name="facelib", nodes=[0, *parts]))
     g.scene = 0
     g.extensionsUsed = ["VRMC_vrm"]
-    g.extensions = {"VRMC_vrm": _vrm_extension(face, rig, nodes, joint_nodes,
+    g.extensions = {"VRMC_vrm": _vrm_extension(face, rig, nodes, joint_nodes, mesh_nodes=parts,
                                                   names=names, meta=meta)}
     blob = b.blob()
     g.buffers.append(lib.Buffer(byteLength=len(blob)))

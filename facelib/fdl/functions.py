@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from facelib.errors import FdlError
-from facelib.fdl import camera, modern, moods
+from facelib.fdl import camera, cast, modern, moods
 from facelib.fdl.context import Context
 from facelib.fdl.thesis import SCRIPT_GLOBALS
 
@@ -56,25 +56,30 @@ FUNCTIONS: Mapping[str, StoryboardFunction] = MappingProxyType({
     for f in (
         StoryboardFunction(
             "say", ("text", "transcript", "audio", "visemes", "at", "lang", "voice", "rate",
-                    "pitch", "style"),
+                    "pitch", "style", "who"),
             'say { "Hello.", audio = "hello.wav", at = 0.5 }', modern.read_say,
             takes_string=True,
         ),
         StoryboardFunction(
-            "show", ("at", "dur", "intensity", "ease_in", "ease_out"),
+            "show", ("at", "dur", "intensity", "ease_in", "ease_out", "who"),
             'show { "joy", dur = 2, intensity = 0.8 }', modern.read_show,
         ),
         StoryboardFunction(
-            "look", ("at", "dur"), 'look { "lookTo", "left", 17, "yes", dur = 2 }',
+            "look", ("at", "dur", "who"), 'look { "lookTo", "left", 17, "yes", dur = 2 }',
             modern.read_look,
         ),
         StoryboardFunction(
-            "camera", ("framing", "at", "dur"),
+            "camera", ("framing", "at", "dur", "who"),
             'camera { framing = "head", at = 2, dur = 0.5 }', camera.read_camera,
         ),
         StoryboardFunction(
-            "mood", ("at", "intensity", "ease"),
+            "mood", ("at", "intensity", "ease", "who"),
             'mood { "happy", at = 2, intensity = 0.6 }', moods.read_mood,
+        ),
+        StoryboardFunction(
+            "characters", None,
+            'characters { ada = { hair = "long" }, ben = { face = "ben.json", hair = "short" } }',
+            cast.read_characters,
         ),
         StoryboardFunction(
             "define_expression", None, 'define_expression { "smirk", raise_l_cornerlip = 120 }',

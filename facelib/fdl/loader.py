@@ -16,15 +16,17 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 import warnings
 from pathlib import Path
 from typing import TypeVar
 
 from facelib.checks import did_you_mean
-from facelib.cues import ExpressionCue, GazeCue, SpeechSpec, Storyboard
+from facelib.cues import Character, ExpressionCue, GazeCue, SpeechSpec, Storyboard
 from facelib.errors import FdlError, FdlWarning, ParameterError
 from facelib.fdl import modern_cues, thesis_cues
 from facelib.fdl.camera import camera_cues
+from facelib.fdl.cast import check_who, part_of, scene_camera, single_camera
 from facelib.fdl.context import Context, line_of_name
 from facelib.fdl.functions import SETTINGS, function_names, known_globals, read_calls
 from facelib.fdl.modern import ModernParts
@@ -205,25 +207,26 @@ def _build(
     fdl_line = fdl_value.line if isinstance(fdl_value, LuaTable) else None
     lists = _thesis_lists(chunk, fdl, fdl_line, ctx, seed=seed, box=box)
     parts = read_calls(_calls(chunk), ctx)
+    check_who(parts, ctx)
+    if parts.characters:
+        return _cast(chunk, parts, has_thesis=bool(lists) or fdl is not None, fdl=fdl,
+                     fdl_line=fdl_line, ctx=ctx, seed=seed, file=file)
     # thesis lists run from 0; the modern syntax's cues without ``at`` follow on
     expressions = thesis_cues.expression_cues(lists.get("expressions"))
     gaze = thesis_cues.gaze_cues(lists.get("eyes"))
     speech = _speech(fdl, fdl_line, lists.get("Sentence"), parts, ctx)
     output = _output(chunk, fdl, fdl_line, ctx)
-    language = _global(chunk, "language")
-    if language is not None and not (isinstance(language, str) and language.strip()):
-        raise FdlError(f"language must be a language code like \"pt\"; got {language!r}",
-                       path=name, line=_line(text, "language"))
+    language = _language(chunk, ctx)
     if output is not None:
         _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
     face_value = _global(chunk, "face")
-    face = (None if face_value is None else resolve_inside(
-        base_dir, face_value, what="face", path=name, line=_line(text, "face")))
+    face = (None if face_value is None
+            else _face_file(face_value, ctx, what="face", line=_line(text, "face")))
     hair, lines = _hair(chunk, text, name)
     return Storyboard(
         path=file,
         fps=fps,
-        language=language.strip() if isinstance(language, str) else None,
+        language=language,
         seed=seed,
         speech=speech,
         expressions=_by_start((*expressions, *modern_cues.expression_cues(
@@ -236,9 +239,88 @@ def _build(
         face=face,
         hair=hair,
         setting_lines=lines,
-        camera=camera_cues(parts.camera, ctx),
+        camera=single_camera(camera_cues(parts.camera, ctx), ctx),
         moods=mood_cues(parts.moods, ctx),
     )
+
+
+def _face_file(value: object, ctx: Context, *, what: str, line: int | None) -> Path:
+    """The face definition a storyboard names (``face = ...``, a character's ``face``):
+    a file inside the storyboard's folder, played through :func:`facelib.clip.styled_face`."""
+    return resolve_inside(ctx.base_dir, value, what=what, path=ctx.path, line=line)
+
+
+def _part_seed(seed: int, index: int) -> int:
+    """The seed of the ``index``-th character's part: the storyboard's for the first, the
+    next ones after it (so two characters never blink together by construction)."""
+    return (seed + index) % 2**63
+
+
+def _cast(
+    chunk: ChunkResult, parts: ModernParts, *, has_thesis: bool,
+    fdl: dict[str, str | None] | None, fdl_line: int | None, ctx: Context, seed: int,
+    file: Path | None,
+) -> Storyboard:
+    """The storyboard of ``characters { ... }``: one part per character (see
+    :mod:`facelib.fdl.cast`), the camera cutting between them."""
+    first = parts.characters[0].line
+    if has_thesis:
+        raise FdlError("the thesis's FDL table and lists have no characters; with characters "
+                       "use say, show, look and mood with who = ...", path=ctx.path, line=first)
+    for setting in ("face", "hair"):
+        if _global(chunk, setting) is not None:
+            raise FdlError(f"{setting}: with characters, give each character's {setting} in "
+                           f'characters {{ name = {{ {setting} = "..." }} }}',
+                           path=ctx.path, line=_assignment_line(ctx.source, setting))
+    language = _language(chunk, ctx)
+    characters = []
+    for index, draft in enumerate(parts.characters):
+        own = part_of(parts, draft.name, ctx)
+        face = (None if draft.face is None else _face_file(
+            draft.face, ctx, what=f"characters: {draft.name}: face", line=draft.line))
+        part = Storyboard(
+            path=file, fps=ctx.fps, language=language, seed=_part_seed(seed, index),
+            speech=None if own.speech is None else modern_cues.speech_spec(own.speech, ctx),
+            turns=tuple(modern_cues.speech_spec(t, ctx) for t in own.turns),
+            expressions=_by_start(modern_cues.expression_cues(own.expressions, ctx)),
+            gaze=_by_start(modern_cues.gaze_cues(own.gaze, ctx)),
+            expression_defs=parts.expression_defs, gaze_defs=parts.gaze_defs,
+            expression_mixes=parts.expression_mixes, face=face, hair=draft.hair,
+            setting_lines={} if draft.hair is None or draft.line is None
+            else {"hair": draft.line},
+            moods=mood_cues(own.moods, ctx))
+        characters.append(Character(draft.name, part, face=face, hair=draft.hair,
+                                    origin=ctx.origin(draft.line)))
+    output = _output(chunk, fdl, fdl_line, ctx)
+    if output is not None:
+        inputs = [file, *(p for c in characters for s in (c.part.speech, *c.part.turns)
+                          for p in _inputs_of(s))]
+        _check_output(output, inputs=tuple(inputs), ctx=ctx)
+    return Storyboard(
+        path=file, fps=ctx.fps, seed=seed, language=language, output=output,
+        expression_defs=parts.expression_defs, gaze_defs=parts.gaze_defs,
+        expression_mixes=parts.expression_mixes,
+        camera=scene_camera(camera_cues(parts.camera, ctx), ctx),
+        characters=tuple(characters))
+
+
+def _assignment_line(text: str, name: str) -> int | None:
+    """The line of a top-level ``name = ...`` (one that starts a line, not a table field
+    such as a character's ``hair = ...``), else the first ``name =`` anywhere."""
+    pattern = re.compile(rf"^\s*{re.escape(name)}\s*=(?!=)")
+    for number, line in enumerate(text.splitlines(), start=1):
+        if pattern.match(line):
+            return number
+    return _line(text, name)
+
+
+def _language(chunk: ChunkResult, ctx: Context) -> str | None:
+    """The ``language`` setting, stripped (None when absent)."""
+    language = _global(chunk, "language")
+    if language is not None and not (isinstance(language, str) and language.strip()):
+        raise FdlError(f"language must be a language code like \"pt\"; got {language!r}",
+                       path=ctx.path, line=_line(ctx.source, "language"))
+    return language.strip() if isinstance(language, str) else None
 
 
 OUTPUT_SUFFIXES = (".fap", ".mp4", ".gif")

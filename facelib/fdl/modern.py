@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from facelib.fdl.functions import StoryboardFunction
 
 __all__ = [
+    "DraftCharacter",
     "DraftCue",
     "DraftSpeech",
     "ModernParts",
@@ -37,6 +38,7 @@ __all__ = [
     "read_say",
     "read_show",
     "table_of",
+    "who_of",
 ]
 
 _SAY_RANGES = {"rate": (0.5, 2.5), "pitch": (0.0, 100.0)}
@@ -55,6 +57,7 @@ class DraftCue:
     intensity: float = 1.0
     ramp_in_ms: int | None = None
     ramp_out_ms: int | None = None
+    who: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,13 +75,32 @@ class DraftSpeech:
     rate: float = 1.0
     pitch: float = 50.0
     style: str | float = "normal"
+    who: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class DraftCharacter:
+    """One entry of ``characters { name = { face = ..., hair = ... } }``: the face still
+    unresolved (None: the bundled head)."""
+
+    name: str
+    line: int | None
+    face: str | None = None
+    hair: str | None = None
 
 
 @dataclass(slots=True)
 class ModernParts:
-    """Everything the storyboard-function calls asked for, in call order."""
+    """Everything the storyboard-function calls asked for, in call order.
+
+    ``speech`` is the one ``say`` of a storyboard of one face; ``speeches`` holds the
+    ``say`` calls of each character (``who =``) of a storyboard that names ``characters``;
+    ``turns`` the ``say`` calls after the first of one character's part."""
 
     speech: DraftSpeech | None = None
+    speeches: dict[str, list[DraftSpeech]] = field(default_factory=dict)
+    turns: list[DraftSpeech] = field(default_factory=list)
+    characters: list[DraftCharacter] = field(default_factory=list)
     expressions: list[DraftCue] = field(default_factory=list)
     gaze: list[DraftCue] = field(default_factory=list)
     expression_defs: dict[str, Mapping[str, float]] = field(default_factory=dict)
@@ -128,6 +150,17 @@ def _name(
             line=line,
         )
     return name
+
+
+def who_of(t: LuaTable, fn: str, ctx: Context, line: int | None) -> str | None:
+    """The ``who = "name"`` field of a call (None when absent); FdlError if it is not a
+    name. Whether the storyboard names that character is checked once all calls are read
+    (:func:`facelib.fdl.cast.check_who`)."""
+    who = t.fields.get("who")
+    if who is not None and not (isinstance(who, str) and who.strip()):
+        raise FdlError(f'{fn}: who must be a character name like who = "ada"; got {who!r}',
+                       path=ctx.path, line=line)
+    return None if who is None else who.strip()
 
 
 def _time(value: object, what: str, ctx: Context, line: int | None) -> int:
@@ -197,6 +230,7 @@ def read_show(
             intensity=float(intensity),
             ramp_in_ms=ease_in,
             ramp_out_ms=ease_out,
+            who=who_of(t, "show", ctx, line),
         )
     )
 
@@ -227,6 +261,7 @@ def read_look(
             at_ms=_opt_time(t.fields, "at", "look", ctx, line),
             duration_ms=_time(t.fields["dur"], "look: dur", ctx, line),
             line=line,
+            who=who_of(t, "look", ctx, line),
         )
     )
 
@@ -234,14 +269,10 @@ def read_look(
 def read_say(
     arg: object, fn: StoryboardFunction, ctx: Context, line: int | None, parts: ModernParts
 ) -> None:
-    """``say "text"`` or ``say { "text" or transcript/audio/visemes, at }``: the speech."""
-    if parts.speech is not None:
-        raise FdlError(
-            f"say is called a second time (the first call is on line {parts.speech.line}); "
-            "a storyboard has one speech",
-            path=ctx.path,
-            line=line,
-        )
+    """``say "text"`` or ``say { "text" or transcript/audio/visemes, at, who }``: the
+    speech (of character ``who`` in a storyboard with characters)."""
+    who = who_of(arg, "say", ctx, line) if isinstance(arg, LuaTable) else None
+    _check_first_say(parts, ctx, line)
     if isinstance(arg, str):
         parts.speech = DraftSpeech(line=line, at_ms=0, text=arg)
         return
@@ -270,8 +301,9 @@ def read_say(
     visemes = None if "visemes" not in f else _visemes(f["visemes"], ctx, line)
     if text is None and "transcript" not in f and "audio" not in f and visemes is None:
         raise FdlError("say needs text, a transcript, audio or visemes", path=ctx.path, line=line)
-    parts.speech = DraftSpeech(
+    said = DraftSpeech(
         line=line,
+        who=who,
         at_ms=_opt_time(f, "at", "say", ctx, line) or 0,
         text=text,
         transcript=strings["transcript"],
@@ -283,6 +315,22 @@ def read_say(
         pitch=numbers["pitch"] if numbers["pitch"] is not None else 50.0,
         style=_style(f, ctx, line),
     )
+    if who is None:
+        parts.speech = said
+    else:
+        parts.speeches.setdefault(who, []).append(said)
+
+
+def _check_first_say(parts: ModernParts, ctx: Context, line: int | None) -> None:
+    """FdlError when the storyboard already has its one ``say`` (a character of a
+    storyboard with characters, ``who = ...``, may speak several times)."""
+    if parts.speech is not None:
+        raise FdlError(
+            f"say is called a second time (the first call is on line {parts.speech.line}); "
+            "a storyboard has one speech (characters, say { who = ... }, may have several)",
+            path=ctx.path,
+            line=line,
+        )
 
 
 def _style(fields: Mapping[str, LuaValue], ctx: Context, line: int | None) -> str | float:

@@ -18,7 +18,7 @@ from facelib.checks import did_you_mean
 from facelib.cues import MoodCue
 from facelib.errors import FdlError
 from facelib.fdl.context import Context
-from facelib.fdl.modern import DraftCue, ModernParts, table_of
+from facelib.fdl.modern import DraftCue, ModernParts, table_of, who_of
 from facelib.fdl.timing import parse_time
 
 if TYPE_CHECKING:
@@ -66,7 +66,8 @@ def read_mood(
         duration_ms=0, line=line, intensity=float(intensity),
         ramp_in_ms=None if ease is None else parse_time(ease, fps=ctx.fps,
                                                         what="mood: ease", path=ctx.path,
-                                                        line=line)))
+                                                        line=line),
+        who=who_of(t, "mood", ctx, line)))
 
 
 def mood_cues(drafts: Sequence[DraftCue], ctx: Context) -> tuple[MoodCue, ...]:

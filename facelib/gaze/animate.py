@@ -87,6 +87,17 @@ def _checked(fps: object, n_frames: object, seed: object) -> tuple[float, int, i
     return check_fps(fps), check_count("n_frames", n_frames), check_seed(seed)
 
 
+def _start_at_rest(planner: Planner, default: BoundBehaviour) -> None:
+    """Start the eyes and the head where the ``default`` behaviour rests (its gaze and head
+    offsets, e.g. toward a partner in a dialogue) rather than straight ahead and turning
+    there in the first second; the library's default rests straight ahead (unchanged)."""
+    gaze_at, head_at = default.gaze_offset_deg, default.head_offset_deg
+    if not any(gaze_at) and not any(head_at):
+        return
+    planner.gaze, planner.gaze_target = Motion(gaze_at), np.asarray(gaze_at, dtype=float)
+    planner.head, planner.head_target = Motion(head_at), np.asarray(head_at, dtype=float)
+
+
 def _mode_lookup(speaking: np.ndarray | None, fps: float, n_frames: int):
     if speaking is None:
         return lambda t: "listening"
@@ -143,6 +154,7 @@ def animate(
     seconds = n_frames / fps
     gaze_rng, blink_rng, fixation_rng = np.random.default_rng(seed).spawn(3)
     planner = Planner(gaze_rng, _mode_lookup(speaking, fps, n_frames), blink_rate=blink_rate)
+    _start_at_rest(planner, default)
 
     segments = _segments(bound, default, seconds)
     for t0, t1, behaviour in segments:

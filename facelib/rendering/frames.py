@@ -77,7 +77,8 @@ def iter_frames(
             if camera is not None:
                 renderer.set_camera(camera.poses[done], znear=camera.znear[done],
                                     zfar=camera.zfar[done])
-            yield renderer.frame(frame_vertices)
+            # the frame's FAPs deepen the skin's wrinkles (facelib/rendering/skin_map.py)
+            yield renderer.frame(frame_vertices, faps=stream.values[done])
             done += 1
             if report is not None:
                 report(done, stream.n_frames)
@@ -201,12 +202,14 @@ def render_still(
     :class:`~facelib.rendering.scene.FaceRenderer` open instead (one OpenGL context).
     """
     face = face_or_default(face)
+    faps = None
     if pose is None:
         vertices = np.asarray(face.vertices, np.float32)
     else:
         pose = np.asarray(pose, np.float32)
         if pose.shape == (N_FAPS,):
             vertices = np.asarray(face.deform_frame(pose), np.float32)
+            faps = pose
         elif pose.ndim == 2 and pose.shape[1] == 3:
             vertices = pose
         else:
@@ -215,4 +218,4 @@ def render_still(
             )
     with FaceRenderer(face, width=width, height=height, background=background,
                       framing=framing) as renderer:
-        return renderer.frame(vertices)
+        return renderer.frame(vertices, faps=faps)

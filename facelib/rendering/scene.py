@@ -40,6 +40,13 @@ from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
 from facelib.rendering.readback import install_colour_readback
 from facelib.rendering.rigid_pieces import RigidGroup, rigid_groups, rigid_pose
+from facelib.rendering.skin_map import (
+    SkinLayout,
+    skin_layout,
+    tint_factors,
+    wrinkle_activation,
+    wrinkle_drivers,
+)
 
 __all__ = [
     "ANTIALIAS",
@@ -68,7 +75,8 @@ class Look:
     ``shading``: ``wrap`` and ``specular`` of the face shader; ``occlusion`` and
     ``occlusion_power``: how the baked ambient occlusion darkens colours (a part's material
     may set its own ``occlusion_strength`` and ``occlusion_power``); ``supersample``: the
-    factor of the fallback anti-aliasing.
+    factor of the fallback anti-aliasing; ``skin_tint``: the skin's colour and shine
+    variation by region (:func:`facelib.rendering.skin_map.tint_factors`).
     """
 
     parts: Mapping[str, Mapping[str, float]]
@@ -83,6 +91,7 @@ class Look:
     occlusion: float = 1.0
     occlusion_power: float = 1.0
     supersample: int = 2
+    skin_tint: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
     def material(self, part: str) -> Mapping[str, float]:
         return self.parts.get(part, self.parts["default"])
@@ -105,6 +114,7 @@ def load_look() -> Look:
         occlusion=float(raw["occlusion"]["strength"]),
         occlusion_power=float(raw["occlusion"]["power"]),
         supersample=int(raw["antialias"]["supersample"]),
+        skin_tint=MappingProxyType(raw.get("skin_tint", {})),
     )
 
 
@@ -383,7 +393,9 @@ def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
     old = getattr(renderer, "_program_cache", None)
     if not isinstance(old, base):
         return
-    shading = {name.upper(): float(value) for name, value in look.shading.items()}
+    # a look made before the skin's shading numbers existed draws smooth, unscattered skin
+    shading = {"WRINKLE_BUMP": 0.0, "WRINKLE_CREASE": 0.0, "SKIN_SCATTER": 0.0}
+    shading.update({name.upper(): float(value) for name, value in look.shading.items()})
 
     class _FaceProgramCache(base):  # type: ignore[valid-type,misc]  # pyrender is untyped
         def __init__(self, shader_dir: str | None = None):
@@ -500,6 +512,7 @@ class FaceRenderer:
         self._pieces = _cull_hidden_sides(
             split_parts(vertices, triangles, getattr(face, "parts", None)), vertices,
             triangles, face, self.look)
+        self._skin_maps(face, vertices)
         self._buffers(face, colors)
         if framing is None:
             framing = "head"
@@ -518,6 +531,68 @@ class FaceRenderer:
         if offscreen:
             self._open(antialias)
 
+    def _skin_maps(self, face: Deformable, vertices: np.ndarray) -> None:
+        """Cut each skin piece in two: the triangles that a wrinkle region reaches, which the
+        face shader creases, and the rest, spared that work (llvmpipe runs every branch of
+        a shader for every pixel). Per piece then: the wrinkle layout (None elsewhere, and
+        where the face lacks the feature points it needs), the skin's tint and surface
+        (shine, roughness) factors, and no wrinkle activation yet (see :meth:`set_faps`)."""
+        normals = vertex_normals(vertices, self._triangles, self._normal_op)
+        self._drivers = wrinkle_drivers()
+        self._activation = np.zeros(len(self._drivers.names), np.float32)
+        pieces: list[PartMesh] = []
+        for piece in self._pieces:
+            layout = (skin_layout(face, piece.vertex_ids, normals[piece.vertex_ids],
+                                  self._drivers) if piece.name == "skin" else None)
+            if layout is None:
+                pieces.append(piece)
+                continue
+            reached = layout.weights.max(axis=(0, 2))[piece.triangles].max(axis=1) > 0
+            for part in (piece.triangles[reached], piece.triangles[~reached]):
+                if len(part):
+                    used = np.unique(part)
+                    pieces.append(PartMesh(piece.name, piece.vertex_ids[used],
+                                           np.searchsorted(used, part).astype(np.uint32),
+                                           piece.double_sided))
+        self._pieces = pieces
+        self._layouts: list[SkinLayout | None] = [None] * len(pieces)
+        for k, piece in enumerate(pieces):
+            if piece.name == "skin":
+                layout = skin_layout(face, piece.vertex_ids, normals[piece.vertex_ids],
+                                     self._drivers)
+                if layout is not None and layout.weights.any():
+                    self._layouts[k] = layout
+        tints = [tint_factors(face, p.vertex_ids, normals[p.vertex_ids], self.look.skin_tint)
+                 if p.name == "skin" else None for p in pieces]
+        self._tints = [None if t is None else t[0] for t in tints]
+        self._surface = [None if t is None else t[1] for t in tints]
+
+    def set_faps(self, faps: np.ndarray | None) -> None:
+        """Deepen the skin's wrinkles as ``faps`` ``(84,)`` (one frame's FAP values, FAP
+        units; None: smooth skin) asks, from the next frame drawn on."""
+        if faps is None:
+            activation = np.zeros_like(self._activation)
+        else:
+            activation = wrinkle_activation(faps, self._drivers)
+        if np.array_equal(activation, self._activation):
+            return
+        self._activation = activation
+        for k, group in enumerate(self._groups):
+            if any(self._layouts[piece] is not None for piece in group.pieces):
+                self._at_rest[k] = False  # re-upload: its depths changed
+        for piece, layout in enumerate(self._layouts):
+            if layout is not None:
+                self._write_wrinkles(piece)
+
+    def _write_wrinkles(self, piece: int) -> None:
+        """Put the current wrinkle depths of ``piece`` into its vertex buffer."""
+        layout = self._layouts[piece]
+        if layout is not None:
+            depth = layout.amplitudes(self._activation)
+            buf = self._interleaved[piece]
+            buf[:, 7] = depth[:, 0]
+            buf[:, 9] = depth[:, 1]
+
     def _buffers(self, face: Deformable, colors: np.ndarray) -> None:
         """Per piece: linear colours with the occlusion factor in alpha, materials, hair
         card coordinates and the interleaved vertex buffer they fill."""
@@ -528,17 +603,30 @@ class FaceRenderer:
         factor = _occlusion_factor(len(colors), getattr(face, "vertex_ao", None),
                                    strength, power)
         linear = srgb_to_linear(colors) * factor[:, None]
-        self._colors = [np.hstack([linear[p.vertex_ids], factor[p.vertex_ids, None]])
-                        for p in self._pieces]
+        self._colors = [np.hstack([linear[p.vertex_ids] * (1.0 if tint is None else tint),
+                                   factor[p.vertex_ids, None]]).astype(np.float32)
+                        for p, tint in zip(self._pieces, self._tints, strict=True)]
         self._materials = [self._material(p) for p in self._pieces]
         self._uv = _piece_uv(self._pieces, getattr(face, "hair_uv", None))
-        # pyrender interleaves position, normal, texcoord_0 (hair only) and colour
-        self._interleaved = [np.empty((len(c), 10 if uv is None else 12), np.float32)
-                             for c, uv in zip(self._colors, self._uv, strict=True)]
-        for buf, color, uv in zip(self._interleaved, self._colors, self._uv, strict=True):
+        # pyrender interleaves position, normal, then tangent (skin that wrinkles: phase and
+        # depth of channels 0 and 1), texcoord_0 (hair: card coordinates), texcoord_1 (skin:
+        # shine and roughness factors) and colour
+        self._interleaved = []
+        for k, (color, uv, layout) in enumerate(zip(self._colors, self._uv, self._layouts,
+                                                   strict=True)):
+            surface = self._surface[k]
+            width = (10 + (0 if uv is None else 2) + (0 if layout is None else 4)
+                     + (0 if surface is None else 2))
+            buf = np.zeros((len(color), width), np.float32)
             buf[:, -4:] = color
             if uv is not None:
                 buf[:, 6:8] = uv
+            if layout is not None:
+                buf[:, 6] = layout.phase[:, 0]
+                buf[:, 8] = layout.phase[:, 1]
+            if surface is not None:
+                buf[:, width - 6 : width - 4] = surface
+            self._interleaved.append(buf)
 
     def _context(self, scale: int) -> Any:
         try:
@@ -615,12 +703,18 @@ class FaceRenderer:
     def _new_meshes(self, vertices: np.ndarray, normals: np.ndarray) -> list[Any]:
         pr = self._pr
         meshes = []
-        for piece, color, material, uv in zip(self._pieces, self._colors, self._materials,
-                                              self._uv, strict=True):
+        for k, (piece, color, material, uv) in enumerate(zip(
+                self._pieces, self._colors, self._materials, self._uv, strict=True)):
+            wrinkled = self._layouts[k] is not None
+            buf = self._interleaved[k]
+            surface = buf[:, -6:-4] if self._surface[k] is not None else None
+            self._write_wrinkles(k)
             primitive = pr.Primitive(
                 positions=vertices[piece.vertex_ids],
                 normals=normals[piece.vertex_ids],
+                tangents=buf[:, 6:10] if wrinkled else None,
                 texcoord_0=uv,
+                texcoord_1=surface,
                 color_0=color,
                 indices=piece.triangles,
                 material=material,
@@ -687,6 +781,7 @@ class FaceRenderer:
 
         for piece, rows in zip(group.pieces, group.rows, strict=True):
             prim, buf = self._primitives[piece], self._interleaved[piece]
+            self._write_wrinkles(piece)
             buf[:, 0:3] = vertices[rows]
             buf[:, 3:6] = normals[rows]
             # keep the primitive's own arrays (bounds, shadows) true to what is drawn
@@ -696,10 +791,15 @@ class FaceRenderer:
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, prim._buffers[0])
             GL.glBufferSubData(GL.GL_ARRAY_BUFFER, 0, buf.nbytes, buf)
 
-    def frame(self, vertices: np.ndarray | None = None) -> np.ndarray:
-        """Render ``vertices`` ``(V, 3)`` (or the current pose) to ``(H, W, 3) uint8`` RGB."""
+    def frame(self, vertices: np.ndarray | None = None, *,
+              faps: np.ndarray | None = None) -> np.ndarray:
+        """Render ``vertices`` ``(V, 3)`` (or the current pose) to ``(H, W, 3) uint8`` RGB;
+        ``faps`` ``(84,)``: the frame's FAP values, which deepen the skin's wrinkles (see
+        :meth:`set_faps`; None keeps the last ones)."""
         if self._renderer is None:
             raise RenderError("this FaceRenderer is closed or was made for a window")
+        if faps is not None:
+            self.set_faps(faps)
         if vertices is not None:
             self.set_vertices(vertices)
         try:

@@ -10,7 +10,7 @@ import numpy as np
 from facelib.checks import check_sample_rate
 from facelib.errors import ParameterError, SpeechError
 
-__all__ = ["ALIGN_RATE", "SILENCE_PEAK", "load_speech", "to_pcm16"]
+__all__ = ["ALIGN_RATE", "SILENCE_PEAK", "load_speech", "read_sound", "to_pcm16"]
 
 ALIGN_RATE = 16000
 """Sample rate of the aligner's acoustic model (Hz)."""
@@ -35,7 +35,7 @@ def load_speech(
             raise SpeechError("an audio array needs a sample_rate, got None")
         data, rate = np.asarray(audio, dtype=np.float64), _rate(sample_rate, "sample_rate")
     else:
-        data, rate = _read_file(Path(audio))
+        data, rate = read_sound(Path(audio))
         name = str(audio)
     if data.ndim == 2:
         data = data.mean(axis=1)
@@ -66,7 +66,7 @@ def _rate(rate: object, source: str) -> int:
         raise SpeechError(exc.message) from None
 
 
-def _read_file(path: Path) -> tuple[np.ndarray, int]:
+def read_sound(path: Path) -> tuple[np.ndarray, int]:
     """The samples ``(n,)`` or ``(n, channels)`` float64 and the rate of the sound file
     ``path``; the rate is checked from the header before any sample is read."""
     import soundfile

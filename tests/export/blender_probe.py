@@ -3,9 +3,10 @@ OUT.json FPS FRAMES JOINTS``): import a ``.glb`` with Blender's own glTF importe
 what Blender made of it as JSON.
 
 FRAMES: comma-separated animation frames (0-based); JOINTS: comma-separated joint-name
-prefixes (``lid_upper_l`` turns every bone ``lid_upper_l_*``). The JSON holds, for the mesh
-object with shape keys, each frame's shape-key values by name, and for each prefix the
-glTF-space (y up) rest positions of the mesh vertices that move when those bones turn.
+prefixes (``lid_upper_l`` turns every bone ``lid_upper_l_*``). The JSON holds the mesh objects'
+names and vertex counts, for each mesh object with shape keys each frame's shape-key values
+by name, and for each prefix and mesh object the glTF-space (y up) rest positions of the
+object's vertices that move when those bones turn.
 """
 
 import json
@@ -53,8 +54,8 @@ def main() -> None:
     meshes = [o for o in scene.objects if o.type == "MESH"]
     keyed = [o for o in meshes if o.data.shape_keys is not None]
     armature = next(o for o in scene.objects if o.type == "ARMATURE")
-    report: dict = {"meshes": [o.name for o in meshes], "bones": [b.name for b in
-                                                                   armature.pose.bones],
+    report: dict = {"meshes": {o.name: len(o.data.vertices) for o in meshes},
+                    "bones": [b.name for b in armature.pose.bones],
                     "frame_start": scene.frame_start, "shape_keys": {}, "follow": {}}
     for obj in keyed:
         blocks = obj.data.shape_keys.key_blocks
@@ -72,17 +73,17 @@ def main() -> None:
         bone.rotation_mode = "QUATERNION"
         bone.rotation_quaternion = (1.0, 0.0, 0.0, 0.0)
         bone.location = (0.0, 0.0, 0.0)
-    skin = max(meshes, key=lambda o: len(o.data.vertices))
-    still = _world_positions(skin)
+    still = {o.name: _world_positions(o) for o in meshes}
     turn = mathutils.Quaternion((1.0, 0.0, 0.0), 0.3)
     for prefix in prefixes:
         chain = [b for b in armature.pose.bones if b.name.rsplit("_", 1)[0] == prefix
                  or b.name == prefix]
         for bone in chain:
             bone.rotation_quaternion = turn
-        moved = _world_positions(skin)
-        report["follow"][prefix] = [_gltf_space(a) for a, b in zip(still, moved, strict=True)
-                                    if (a - b).length > 1e-5]
+        report["follow"][prefix] = {
+            o.name: [_gltf_space(a) for a, b in zip(still[o.name], _world_positions(o),
+                                                    strict=True) if (a - b).length > 1e-5]
+            for o in meshes}
         for bone in chain:
             bone.rotation_quaternion = (1.0, 0.0, 0.0, 0.0)
     Path(out).write_text(json.dumps(report))

@@ -1,5 +1,6 @@
 """An independent glTF evaluator for the tests: accessors (sparse included), morph targets
-and linear blend skinning at a keyframe, as the glTF 2.0 specification defines them."""
+and linear blend skinning at a keyframe, as the glTF 2.0 specification defines them, for
+every node with a mesh (facelib writes one per part) and its own weights channel."""
 
 from __future__ import annotations
 
@@ -19,7 +20,8 @@ _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 
 class Gltf:
     def __init__(self, path: Path):
-        self.g = pygltflib.GLTF2.load(str(path))
+        binary = Path(path).read_bytes()[:4] == b"glTF"  # .glb, .vrm, .vrma
+        self.g = (pygltflib.GLTF2.load_binary if binary else pygltflib.GLTF2.load)(str(path))
         self.blob = self.g.binary_blob()
 
     def _view(self, index: int, dtype: type, count: int, width: int, offset: int = 0):
@@ -40,18 +42,30 @@ class Gltf:
             out[ids[:, 0]] = self._view(s.values.bufferView, dtype, s.count, width)
         return out
 
+    @property
+    def mesh_nodes(self) -> list[int]:
+        """The nodes that hold a mesh, in node order."""
+        return [i for i, n in enumerate(self.g.nodes) if n.mesh is not None]
+
+    def _mesh_of(self, node: int):
+        return self.g.meshes[self.g.nodes[node].mesh]
+
     def local_matrices(self, frame: int) -> list[np.ndarray]:
-        """Every node's local matrix at keyframe ``frame`` of the first animation."""
+        """Every node's local matrix at keyframe ``frame`` of the first animation (and each
+        mesh node's morph weights: its channel's, else its mesh's default)."""
         trs = {i: [np.array(n.translation or [0, 0, 0], float),
                    np.array(n.rotation or [0, 0, 0, 1], float)]
                for i, n in enumerate(self.g.nodes)}
-        weights = None
+        weights = {i: np.array(self._mesh_of(i).weights or [], float) for i in self.mesh_nodes}
+        targets = set()
         for ch in self.g.animations[0].channels:
+            assert (ch.target.node, ch.target.path) not in targets  # the spec: once each
+            targets.add((ch.target.node, ch.target.path))
             sampler = self.g.animations[0].samplers[ch.sampler]
             out = self.accessor(sampler.output)
             if ch.target.path == "weights":
-                n_targets = len(self.g.meshes[0].weights)
-                weights = out.reshape(-1, n_targets)[frame].astype(float)
+                n_targets = len(self._mesh_of(ch.target.node).weights)
+                weights[ch.target.node] = out.reshape(-1, n_targets)[frame].astype(float)
             elif ch.target.path == "rotation":
                 trs[ch.target.node][1] = out[frame].astype(float)
             elif ch.target.path == "translation":
@@ -66,7 +80,8 @@ class Gltf:
         return mats
 
     def evaluate(self, frame: int) -> list[np.ndarray]:
-        """World positions (Vp, 3) of each primitive of mesh 0 at keyframe ``frame``."""
+        """World positions (Vp, 3) of each primitive of each mesh node (node order) at
+        keyframe ``frame``."""
         return self.pose(self.local_matrices(frame))
 
     def rest_matrices(self) -> list[np.ndarray]:
@@ -77,12 +92,23 @@ class Gltf:
             m[:3, :3] = Rotation.from_quat(n.rotation or [0, 0, 0, 1]).as_matrix()
             m[:3, 3] = n.translation or [0, 0, 0]
             mats.append(m)
-        self._weights = np.zeros(len(self.g.meshes[0].weights or []))
+        self._weights = {i: np.zeros(len(self._mesh_of(i).weights or []))
+                         for i in self.mesh_nodes}
         return mats
 
+    @property
+    def weights(self) -> np.ndarray:
+        """(T,) the morph weights of the last ``local_matrices`` / ``rest_matrices``: every
+        mesh node's, which must all be equal (facelib's parts play the same weights)."""
+        (first, *others) = self._weights.values()
+        for w in others:
+            np.testing.assert_array_equal(w, first)
+        return first
+
     def pose(self, local: list[np.ndarray]) -> list[np.ndarray]:
-        """World positions (Vp, 3) of each primitive of mesh 0 with the nodes' local matrices
-        ``local`` and the morph weights of the last ``local_matrices``/``rest_matrices``."""
+        """World positions (Vp, 3) of each primitive of each mesh node (node order) with the
+        nodes' local matrices ``local`` and the morph weights of the last
+        ``local_matrices``/``rest_matrices``; every mesh node uses skin 0."""
         parent = {c: i for i, n in enumerate(self.g.nodes) for c in (n.children or [])}
 
         def world(i: int) -> np.ndarray:
@@ -92,10 +118,17 @@ class Gltf:
         inverse = self.accessor(skin.inverseBindMatrices).reshape(-1, 4, 4).transpose(0, 2, 1)
         joint_mats = np.stack([world(j) @ inverse[k] for k, j in enumerate(skin.joints)])
         out = []
-        for prim in self.g.meshes[0].primitives:
+        for node in self.mesh_nodes:
+            assert self.g.nodes[node].skin == 0
+            out.extend(self._skinned(node, joint_mats))
+        return out
+
+    def _skinned(self, node: int, joint_mats: np.ndarray) -> list[np.ndarray]:
+        out = []
+        for prim in self._mesh_of(node).primitives:
             pos = self.accessor(prim.attributes.POSITION).astype(float)
             for t, target in enumerate(prim.targets or []):
-                pos += self._weights[t] * self.accessor(target["POSITION"])
+                pos += self._weights[node][t] * self.accessor(target["POSITION"])
             joints = self.accessor(prim.attributes.JOINTS_0).astype(int)
             weights = self.accessor(prim.attributes.WEIGHTS_0).astype(float)
             homo = np.c_[pos, np.ones(len(pos))]

@@ -1,8 +1,9 @@
 """Blender (Debian's ``blender`` package, headless) imports facelib's ``.glb`` with its own glTF
-importer: the shape keys play the exported weights, negative FAP values included (issue 36:
-Blender clamps shape-key values to [0, 1], so a signed FAP is two targets), and the joints
-named for a part move that part. The default head and an own head set up from the cartoon
-example's mesh and landmarks."""
+importer: each part comes in as its own object named for it (issue 36), the shape keys of
+every part play the exported weights, negative FAP values included (Blender clamps
+shape-key values to [0, 1], so a signed FAP is two targets), and the joints named for a part
+move that part. The default head and an own head set up from the cartoon example's mesh and
+landmarks."""
 
 import json
 import shutil
@@ -16,6 +17,7 @@ from scipy.spatial import cKDTree
 from facelib import FapStream
 from facelib.engine import default_face
 from facelib.export import export_gltf
+from facelib.export.gltf import primitive_vertex_ids
 from facelib.mpeg4 import fap
 
 pytestmark = [
@@ -26,7 +28,8 @@ pytestmark = [
 PROBE = Path(__file__).with_name("blender_probe.py")
 HEADS = Path(__file__).parents[2] / "examples" / "heads"
 FRAMES = (0, 2, 5, 8, 11)
-JOINTS = ("lid_upper_l", "lid_upper_r", "lid_lower_l", "lid_lower_r", "eye_l", "eye_r", "jaw")
+JOINTS = ("lid_upper_l", "lid_upper_r", "lid_lower_l", "lid_lower_r", "eyeball_l", "eyeball_r",
+          "jaw")
 
 
 def _stream(n: int = 12) -> FapStream:
@@ -68,9 +71,21 @@ def test_blender_plays_the_exported_weights_and_joints_move_their_parts(head, tm
     stream = _stream()
     result = export_gltf(stream, tmp_path / "face.glb", face=head)
     report = _in_blender(result.path, tmp_path)
-    (keys,) = report["shape_keys"].values()
-    assert keys.pop("_slider_min") == 0.0  # Blender's default range: no negative values
+    # one object per part, named for it, with the part's own vertices (and the copies of the
+    # neck loop that the bust's joining triangles use)
+    assert report["meshes"] == {name: len(primitive_vertex_ids(part))
+                                for name, part in head.parts.items()}
+    assert set(report["shape_keys"]) == set(head.parts)
     assert np.any(stream.values[list(FRAMES)] < 0)
+    for part, keys in report["shape_keys"].items():
+        assert keys.pop("_slider_min") == 0.0, part  # Blender's default: no negative values
+        _check_keys(keys, result, stream)
+    _check_joints(head, report["follow"])
+
+
+def _check_keys(keys: dict, result, stream: FapStream) -> None:
+    """One object's shape keys at FRAMES: each the exported weight, and each FAP's keys times
+    their scales its value."""
     for frame in FRAMES:
         got = keys[str(frame)]
         assert len(got) == len(result.targets)
@@ -86,31 +101,36 @@ def test_blender_plays_the_exported_weights_and_joints_move_their_parts(head, tm
                        for t, s in zip(result.targets, result.scales, strict=True)
                        if t == number)
             assert back == pytest.approx(stream.values[frame, number - 1], abs=1e-3)
-    _check_joints(head, report["follow"])
 
 
 def _check_joints(face, follow: dict) -> None:
     """Each chain moves vertices on its own side (the face's left is +x) and of its own
-    part: upper lids above the eye centre, lower lids below, eyes within the eyeball, the
-    jaw (lower teeth, not upper) below the eyes."""
+    part: the eyeball joints the whole eye object and nothing else; the lids the skin (and
+    lashes), upper lids above the eye centre, lower lids below; the jaw the whole lower
+    teeth object, not the upper teeth, all below the eyes."""
     for name in JOINTS:
-        moved = np.array(follow[name]).reshape(-1, 3)
+        by_part = {part: np.array(v).reshape(-1, 3) for part, v in follow[name].items()}
+        moved = np.concatenate(list(by_part.values()))
         assert len(moved) > 10, name
         if name == "jaw":
             below = min(face.pivots["eye_l"][1], face.pivots["eye_r"][1])
             assert np.all(moved[:, 1] < below), name
+            assert len(by_part["teeth_lower"]) == face.parts["teeth_lower"].vertex_ids.size
+            assert len(by_part["teeth_upper"]) == 0, "the upper teeth stay"
             teeth = face.vertices[face.parts["teeth_lower"].vertex_ids]
-            assert cKDTree(moved).query(teeth)[0].max() < 1e-6, "the lower teeth follow"
-            upper = face.vertices[face.parts["teeth_upper"].vertex_ids]
-            assert cKDTree(moved).query(upper)[0].min() > 0, "the upper teeth stay"
+            assert cKDTree(by_part["teeth_lower"]).query(teeth)[0].max() < 1e-6
             continue
         side = name[-1]
         centre = face.pivots[f"eye_{side}"]
         assert np.all(np.sign(moved[:, 0]) == (1 if side == "l" else -1)), name
-        if name.startswith("eye"):
-            ball = face.vertices[face.parts[name].vertex_ids]
+        if name.startswith("eyeball"):
+            part = f"eye_{side}"
+            assert {p for p, v in by_part.items() if len(v)} == {part}, name
+            assert len(by_part[part]) == face.parts[part].vertex_ids.size, name
+            ball = face.vertices[face.parts[part].vertex_ids]
             radius = np.linalg.norm(ball - centre, axis=1).max()
             assert np.linalg.norm(moved - centre, axis=1).max() <= radius + 1e-5, name
             continue
+        assert len(by_part["skin"]) > 10, name
         above = float((moved[:, 1] > centre[1]).mean())
         assert above > 0.75 if "upper" in name else above < 0.25, (name, above)

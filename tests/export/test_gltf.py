@@ -50,7 +50,8 @@ def test_each_primitive_indexes_its_own_vertices_the_bust_copies_the_neck_loop(e
     result, _ = exported
     face = default_face()
     gltf = Gltf(result.path)
-    prims = dict(zip(face.parts, gltf.g.meshes[0].primitives, strict=True))
+    prims = {m.name: m.primitives[0] for m in gltf.g.meshes}
+    assert list(prims) == list(face.parts)
     for name, prim in prims.items():
         positions = gltf.accessor(prim.attributes.POSITION)
         tris = gltf.accessor(prim.indices).reshape(-1, 3)
@@ -64,6 +65,40 @@ def test_each_primitive_indexes_its_own_vertices_the_bust_copies_the_neck_loop(e
     normals = [gltf.accessor(prims[n].attributes.NORMAL) for n in ("skin", "bust")]
     at_skin = np.searchsorted(np.sort(face.parts["skin"].vertex_ids), borrowed)
     np.testing.assert_allclose(normals[1][bust.vertex_ids.size:], normals[0][at_skin])
+
+
+def test_each_part_is_its_own_mesh_and_node_all_on_one_skin(exported):
+    """Issue 36: one mesh and one node per part, named for it, so that Blender, Unity and
+    three.js show each as its own object; every part has the same targets (names and
+    count) and its own weights channel, all channels reading one sampler; one skin."""
+    result, _ = exported
+    face = default_face()
+    g = Gltf(result.path).g
+    assert result.parts == tuple(face.parts)
+    assert [m.name for m in g.meshes] == list(face.parts)
+    mesh_nodes = [i for i, n in enumerate(g.nodes) if n.mesh is not None]
+    assert [g.nodes[i].name for i in mesh_nodes] == list(face.parts)
+    assert [g.nodes[i].mesh for i in mesh_nodes] == list(range(len(face.parts)))
+    assert all(g.nodes[i].skin == 0 for i in mesh_nodes) and len(g.skins) == 1
+    assert all(len(m.primitives) == 1 for m in g.meshes)
+    # scene roots (the validator warns of a skinned mesh under a parent), after the node
+    # above the skeleton (so that Blender names its objects for the parts); names unique
+    assert g.scenes[0].nodes == [0, *mesh_nodes] and g.nodes[0].children == [g.skins[0].joints[0]]
+    assert len({n.name for n in g.nodes}) == len(g.nodes)
+    for m in g.meshes:
+        assert m.extras["targetNames"] == list(result.names)
+        assert len(m.primitives[0].targets) == len(m.weights) == len(result.names)
+    channels = [c for c in g.animations[0].channels if c.target.path == "weights"]
+    assert sorted(c.target.node for c in channels) == mesh_nodes
+    assert len({c.sampler for c in channels}) == 1
+    # the eyes, lower teeth and tongue are still skinned to their joints
+    joints = [g.nodes[j].name for j in g.skins[0].joints]
+    gltf = Gltf(result.path)
+    for part, joint in (("eye_l", "eyeball_l"), ("eye_r", "eyeball_r"), ("teeth_lower", "jaw"),
+                        ("tongue", "jaw")):
+        prim = g.meshes[list(face.parts).index(part)].primitives[0]
+        used = np.unique(gltf.accessor(prim.attributes.JOINTS_0)[:, 0])
+        assert [joints[k] for k in used] == [joint], part
 
 
 def test_vertex_colours_carry_the_baked_occlusion(exported):
@@ -94,7 +129,7 @@ def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
     assert len(names) == len(result.targets) == len(g.meshes[0].primitives[0].targets)
     assert all(g.accessors[t["POSITION"]].bufferView is None
                and g.accessors[t["NORMAL"]].bufferView is None
-               for p in g.meshes[0].primitives for t in p.targets)
+               for m in g.meshes for p in m.primitives for t in p.targets)
     skin = g.meshes[0].primitives[0]
     moved = [g.accessors[t["POSITION"]].sparse for t in skin.targets]
     # sparse: each target moves a part of the skin (the learned jaw field of issue 14, the
@@ -102,7 +137,7 @@ def test_targets_are_sparse_and_only_what_the_stream_uses(exported):
     assert all(s is not None and 0 < s.count < 0.6 * g.accessors[skin.attributes.POSITION].count
                for s in moved)
     # 6 parts, lashes, and the attached bust, garment and hair
-    assert [p.material for p in g.meshes[0].primitives] == list(range(10))
+    assert [p.material for m in g.meshes for p in m.primitives] == list(range(10))
     extras = g.asset.extras["facelib"]
     assert extras["n_frames"] == 12 and extras["fps"] == 25
 
@@ -160,7 +195,7 @@ def test_no_negative_morph_weights_a_signed_fap_is_two_targets(tmp_path):
     result = export_gltf(stream, tmp_path / "signs.glb")
     gltf = Gltf(result.path)
     gltf.local_matrices(0)
-    animated = np.stack([(gltf.local_matrices(i), gltf._weights)[1] for i in range(n)])
+    animated = np.stack([(gltf.local_matrices(i), gltf.weights)[1] for i in range(n)])
     assert animated.min() >= 0 and animated.max() <= 1 + 1e-6
     lip, jaw, corner = (fap(k).id for k in ("raise_b_midlip", "open_jaw",
                                                 "stretch_l_cornerlip"))

@@ -52,7 +52,7 @@ def exported(tmp_path_factory, cartoon):
 
 
 def _animated_weights(gltf: Gltf, n: int) -> np.ndarray:
-    return np.stack([(gltf.local_matrices(i), gltf._weights)[1] for i in range(n)])
+    return np.stack([(gltf.local_matrices(i), gltf.weights)[1] for i in range(n)])
 
 
 def test_52_arkit_named_targets_weighted_by_the_arkit_curves(exported):
@@ -104,7 +104,7 @@ def test_own_heads_targets_move_their_own_parts(exported, cartoon):
         moved = face.deform_frame(recipes[names.index(name)])
         assert sign * (moved[fp[point], axis] - rest[fp[point], axis]) > 1e-3, name
     skin = list(face.parts).index("skin")
-    prim = gltf.g.meshes[0].primitives[skin]
+    prim = gltf.g.meshes[skin].primitives[0]
     blink = gltf.accessor(prim.targets[names.index("eyeBlinkLeft")]["POSITION"])
     ids = np.sort(face.parts["skin"].vertex_ids)
     lid = int(np.searchsorted(ids, fp["3.1"]))

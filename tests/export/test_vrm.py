@@ -91,9 +91,17 @@ def test_extension_header_meta_and_presets_bind_existing_targets(vrm):
     assert "MIT" in meta["copyrightInformation"] and meta["otherLicenseUrl"]
     preset = ext["expressions"]["preset"]
     assert set(preset) == set(PRESETS) and result.presets == tuple(preset)
+    # one mesh node per part, named for it; every preset binds its target on each of them
+    face = default_face()
+    mesh_nodes = [i for i, n in enumerate(glb.doc["nodes"]) if "mesh" in n]
+    assert [glb.doc["nodes"][i]["name"] for i in mesh_nodes] == list(face.parts)
+    assert result.parts == tuple(face.parts)
     names = None
     for name, expression in preset.items():
-        for bind in expression["morphTargetBinds"]:
+        binds = expression["morphTargetBinds"]
+        assert [b["node"] for b in binds] == mesh_nodes, name
+        assert len({b["index"] for b in binds}) == 1, name
+        for bind in binds:
             node = glb.doc["nodes"][bind["node"]]
             mesh = glb.doc["meshes"][node["mesh"]]
             names = mesh["extras"]["targetNames"]
@@ -103,9 +111,11 @@ def test_extension_header_meta_and_presets_bind_existing_targets(vrm):
 
 
 def _skin_primitive(glb):
-    mesh = glb.doc["meshes"][0]
+    node = next(n for n in glb.doc["nodes"] if n.get("name") == "skin" and "mesh" in n)
+    (prim,) = glb.doc["meshes"][node["mesh"]]["primitives"]
     skin = next(i for i, m in enumerate(glb.doc["materials"]) if m["name"] == "skin")
-    return next(p for p in mesh["primitives"] if p["material"] == skin)
+    assert prim["material"] == skin
+    return prim
 
 
 def _nearest(positions, point):
@@ -181,7 +191,9 @@ def test_humanoid_has_the_required_bones_in_the_required_order(vrm):
     look = glb.doc["extensions"]["VRMC_vrm"]["lookAt"]
     assert look["type"] == "bone" and look["offsetFromHeadBone"][2] > 0.05
     first = glb.doc["extensions"]["VRMC_vrm"]["firstPerson"]["meshAnnotations"]
-    assert first == [{"node": 0, "type": "auto"}]
+    mesh_nodes = [i for i, n in enumerate(glb.doc["nodes"]) if "mesh" in n]
+    assert first == [{"node": i, "type": "auto"} for i in mesh_nodes]
+    assert len(mesh_nodes) == len(face.parts)
 
 
 def test_refuses_other_suffixes_and_meta_without_author(tmp_path):

@@ -174,7 +174,8 @@ def _without_lashes(face):  # type: ignore[no-untyped-def]
     parts = {k: v for k, v in face.parts.items() if k != "lashes"}
     return SimpleNamespace(vertices=face.vertices, triangles=face.triangles[keep],
                            vertex_colors=face.vertex_colors, parts=parts,
-                           vertex_ao=face.vertex_ao)
+                           vertex_ao=face.vertex_ao, feature_points=face.feature_points,
+                           fapu=face.fapu)
 
 
 @pytest.mark.parametrize("closure", [0.0, 1024.0])

@@ -24,6 +24,21 @@
 // reflected inside the fibre comes out. The card is cut into HAIR_STRANDS strands across,
 // each a little lighter or darker and ending a little earlier (HAIR_TIPS), so a card reads
 // as a lock of hair, not a ribbon. Both faces of a card are lit (normal toward the viewer).
+//
+// Skin (primitives with texcoord_1 = its shine and roughness factors; the ones a wrinkle
+// region reaches also carry tangent = two wrinkle channels; facelib/rendering/skin_map.py)
+// gets three more things:
+//   wrinkles: two channels of (phase s, depth a); the skin is creased where s is a whole
+//     number: the valley profile v (about ((1 + cos 2 pi s) / 2)^2, see crease) darkens
+//     the colour by 1 - WRINKLE_CREASE * a * v and tilts the normal across the line by the
+//     slope of the height -a * v (times WRINKLE_BUMP), along the world-space gradient of s (from
+//     screen derivatives, as the hair's tangent); lines finer than about three pixels fade
+//     out instead of aliasing;
+//   scattering: the wrap is wider in red and narrower in blue (SKIN_SCATTER), so the
+//     terminator warms as light scattered under the skin comes out red;
+//   shine and roughness: the specular and the roughness times per-vertex factors
+//     (texcoord_1; the look's skin_tint: an oilier forehead and nose, glossier lips, the
+//     wet line of the lower lids).
 
 struct DirectionalLight {
     vec3 color;
@@ -53,6 +68,30 @@ out vec4 frag_color;
 
 const float PI = 3.141592653589793;
 
+#ifdef TEXCOORD_1_LOC
+in vec2 surface;
+#endif
+#ifdef TANGENT_LOC
+in vec4 wrinkle;
+
+// the crease of one wrinkle channel (phase s, depth a, the screen derivatives ds of s, the
+// world-space gradient g of s, the normal n): adds the normal's tilt to tilt and returns the
+// darkening factor. The valley is v = b^2 with b = 1 - 3x^2 + 2x^3 (a cubic as round as
+// (1 + cos 2 pi s) / 2, without its cost on a software rasteriser), x = 2 |s - round(s)|.
+float crease(float s, float a, vec2 ds, vec3 g, vec3 n, inout vec3 tilt)
+{
+    a *= clamp(1.6 - 3.0 * (abs(ds.x) + abs(ds.y)), 0.0, 1.0);
+    float d = s - floor(s + 0.5);
+    float x = 2.0 * abs(d);
+    float b = 1.0 - x * x * (3.0 - 2.0 * x);
+    // dv/ds = 2 b db/dx dx/ds = 2 b (-6 x (1 - x)) (2 sign d)
+    float slope = -24.0 * b * x * (1.0 - x) * sign(d);
+    vec3 gt = g - n * dot(n, g);
+    tilt += (float(WRINKLE_BUMP) * a * slope * inversesqrt(max(dot(gt, gt), 1e-30))) * gt;
+    return 1.0 - float(WRINKLE_CREASE) * a * b * b;
+}
+#endif
+
 #ifdef TEXCOORD_0_LOC
 in vec2 hair_uv;
 
@@ -73,7 +112,12 @@ void main()
 {
     vec3 n = normalize(world_normal);
     vec3 v = normalize(cam_pos - world_position);
+#ifdef TEXCOORD_1_LOC
+    float roughness = clamp(material.roughness_factor * surface.y, 0.04, 1.0);
+    float shine = surface.x;
+#else
     float roughness = clamp(material.roughness_factor, 0.04, 1.0);
+#endif
     float r2 = roughness * roughness;
     float shininess = max(2.0 / (r2 * r2) - 2.0, 1.0);
     float lobe = float(SPECULAR) * (shininess + 8.0) / (8.0 * PI);
@@ -102,7 +146,7 @@ void main()
     vec3 t1 = normalize(t + float(HAIR_SHIFT) * n);
     vec3 t2 = normalize(t - float(HAIR_SHIFT) * n);
     for (int i = 0; i < n_directional_lights; i++) {
-        vec3 l = -normalize(directional_lights[i].direction);
+        vec3 l = -directional_lights[i].direction;  // unit: a rigid pose's -z axis
         vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
         float nl = dot(n, l);
         diffuse += radiance * max((nl + wrap) / (1.0 + wrap), 0.0);
@@ -112,14 +156,43 @@ void main()
                                       + float(HAIR_SHEEN) * strand_lobe(t2, h, 0.25 * float(HAIR_GLOSS)) * 4.0 * base);
     }
 #else
+#ifdef TEXCOORD_1_LOC
+#ifdef TANGENT_LOC
+    vec3 dp1 = dFdx(world_position);
+    vec3 dp2 = dFdy(world_position);
+    vec2 ds0 = vec2(dFdx(wrinkle.x), dFdy(wrinkle.x));
+    vec2 ds1 = vec2(dFdx(wrinkle.z), dFdy(wrinkle.z));
+    vec3 across = cross(dp1, dp2);
+    vec3 ex = cross(dp2, across);
+    vec3 ey = cross(across, dp1);
+    vec3 tilt = vec3(0.0);
+    float folded = crease(wrinkle.x, wrinkle.y, ds0, ds0.x * ex + ds0.y * ey, n, tilt)
+                   * crease(wrinkle.z, wrinkle.w, ds1, ds1.x * ex + ds1.y * ey, n, tilt);
+    n = normalize(n + tilt);
+    base *= folded;
+#endif
+    vec3 wraps = wrap * (vec3(1.0) + float(SKIN_SCATTER) * vec3(0.8, -0.15, -0.4));
     for (int i = 0; i < n_directional_lights; i++) {
-        vec3 l = -normalize(directional_lights[i].direction);
+        vec3 l = -directional_lights[i].direction;  // unit: a rigid pose's -z axis
+        vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
+        float nl = dot(n, l);
+        diffuse += radiance * max((vec3(nl) + wraps) / (vec3(1.0) + wraps), 0.0);
+        float nh = max(dot(n, normalize(l + v)), 0.0);
+        specular += radiance * (lobe * shine * pow(nh, shininess) * max(nl, 0.0));
+    }
+#ifdef TANGENT_LOC
+    specular *= folded;
+#endif
+#else
+    for (int i = 0; i < n_directional_lights; i++) {
+        vec3 l = -directional_lights[i].direction;  // unit: a rigid pose's -z axis
         vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
         float nl = dot(n, l);
         diffuse += radiance * max((nl + wrap) / (1.0 + wrap), 0.0);
         float nh = max(dot(n, normalize(l + v)), 0.0);
         specular += radiance * (lobe * pow(nh, shininess) * max(nl, 0.0));
     }
+#endif
 #endif
     vec3 color = base * (diffuse / PI + ambient_light) + occlusion * specular;
     frag_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);

@@ -14,6 +14,16 @@ layout(location = COLOR_0_LOC) in vec4 color_0;
 layout(location = TEXCOORD_0_LOC) in vec2 texcoord_0;  // hair cards: (card + across, root to tip)
 out vec2 hair_uv;
 #endif
+#ifdef TEXCOORD_1_LOC
+// skin: its shine and roughness factors (facelib/rendering/skin_map.py)
+layout(location = TEXCOORD_1_LOC) in vec2 texcoord_1;
+out vec2 surface;
+#endif
+#ifdef TANGENT_LOC
+// skin that wrinkles: (phase, depth) of wrinkle channels 0 and 1
+layout(location = TANGENT_LOC) in vec4 tangent;
+out vec4 wrinkle;
+#endif
 layout(location = INST_M_LOC) in mat4 inst_m;
 
 uniform mat4 M;
@@ -31,9 +41,18 @@ void main()
     vec4 world = model * vec4(position, 1.0);
     gl_Position = P * V * world;
     world_position = world.xyz;
-    world_normal = mat3(transpose(inverse(model))) * normal;
+    // facelib's node poses are rigid (rotations and translations), so the model matrix's
+    // upper 3x3 turns normals as it turns positions (face.frag normalises): no inverse per
+    // vertex, which llvmpipe pays on the thread that also bins the triangles
+    world_normal = mat3(model) * normal;
 #ifdef TEXCOORD_0_LOC
     hair_uv = texcoord_0;
+#endif
+#ifdef TEXCOORD_1_LOC
+    surface = texcoord_1;
+#endif
+#ifdef TANGENT_LOC
+    wrinkle = tangent;
 #endif
 #ifdef COLOR_0_LOC
     albedo = color_0.rgb;
