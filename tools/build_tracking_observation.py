@@ -7,7 +7,8 @@ Usage (from the repository root; needs the ``render`` and ``track`` extras)::
         [--validate] [--no-write]
         [--keep-lip-rule] [--fresh]
 
-(the packaged model of issue 37: ``--keep-lip-rule`` with the defaults)
+(the packaged model of issue 37: the defaults with ``--keep-lip-rule --lids-from OLD.npz``,
+OLD.npz the model before it, see ``--lids-from``)
 
 1. Training streams are drawn at random (one per seed): every 3 frames a new face pose (a
    random viseme and expression of facelib's own libraries at random weights, plus independent
@@ -45,6 +46,7 @@ Deterministic up to MediaPipe's and the renderer's own floating point.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import hashlib
 import json
 from collections.abc import Sequence
@@ -85,6 +87,7 @@ from facelib.tracking.observation import (
     ObservationModel,
     gaze_region,
     learn_observation,
+    load_observation,
     save_observation,
 )
 from facelib.tracking.pose import HEAD_FAP_IDS
@@ -384,6 +387,23 @@ def cached_track(stream: FapStream, cache: Path, fresh: bool, face: Face | None 
     return landmarks, brows
 
 
+LOWER_LIDS = (21, 22)
+
+
+def with_columns_of(model: ObservationModel, other: ObservationModel,
+                    faps: tuple[int, ...]) -> ObservationModel:
+    """``model`` with the estimator columns and bounds of ``faps`` taken from ``other``
+    (same landmarks, same FAPs): each FAP's column reads the same landmark motion on its
+    own, so columns of two models can be put together."""
+    if list(model.faps) != list(other.faps) or model.estimator.shape != other.estimator.shape:
+        raise SystemExit("the two models read different FAPs or landmarks")
+    cols = [int(np.flatnonzero(model.faps == f)[0]) for f in faps]
+    estimator, bounds = np.array(model.estimator), np.array(model.bounds)
+    estimator[..., cols] = other.estimator[..., cols]
+    bounds[cols] = other.bounds[cols]
+    return dataclasses.replace(model, estimator=estimator, bounds=bounds)
+
+
 def write_lip_rule(tracks: Sequence[np.ndarray], streams: Sequence[FapStream]) -> None:
     """Learn the closed-lips threshold and the open lips' gain of
     :mod:`facelib.tracking.lipclosure` from the training streams' frames (default head;
@@ -464,6 +484,12 @@ def main() -> None:
     parser.add_argument("--no-write", action="store_true",
                         help="do not write the packaged model and threshold")
     parser.add_argument("--fresh", action="store_true", help="render again, ignore the cache")
+    parser.add_argument("--lids-from", type=Path, default=None,
+                        help="take the lower lids' FAPs 21/22 (estimator columns and bounds) "
+                        "from this model file: issue 37's packaged model takes them from the "
+                        "model before it (git show 7a0c8e4:facelib/data/tracking/"
+                        "observation_mediapipe.npz), whose streams had no solo groups; with "
+                        "them SOMA-X's lower lids on hello read 0.63/0.69 instead of 0.89/0.88")
     parser.add_argument("--keep-lip-rule", action="store_true",
                         help="leave lip_closure.json as it is (issue 37's build: the streams "
                         "with solo groups learn a closed-lips threshold of 0.117 MNS0, twice "
@@ -498,6 +524,8 @@ def main() -> None:
     model = learn_observation(landmarks[~lost], values[~lost], neutral=(0, NEUTRAL),
                               components=args.components, brows=brows[~lost],
                               regions=(gaze_region(),), segments=segments)
+    if args.lids_from is not None:
+        model = with_columns_of(model, load_observation(args.lids_from), LOWER_LIDS)
     if not args.no_write and not args.keep_lip_rule:
         write_lip_rule(*zip(*[(t, s) for t, s, h in zip(tracks, streams, heads, strict=True)
                               if not h], strict=True))
