@@ -9,6 +9,8 @@ visemes by every path:
 - ``phone loop``: audio alone, pocketsphinx's phone loop (``recognize(method="phones")``);
 - ``two-pass``: audio alone, pocketsphinx's word decoder with the language model its wheel
   ships, then forced alignment of that transcript (``recognize(method="words")``);
+- ``acoustic``: audio alone, the acoustic viseme model (``recognize(method="acoustic")``,
+  any language; ``benchmarks/visemes_acoustic.py`` measures it further);
 - ``default``: ``facelib.visemes_from_audio(wav)``, two-pass with the phone-loop fallback.
 
 Both the truth and each path go through the same phone -> viseme chain
@@ -55,6 +57,7 @@ PATHS: dict[str, Callable[[Path, str], SpeechTimeline]] = {
     "forced": align,
     "phone loop": lambda wav, _: with_visemes(recognize(wav, method="phones")),
     "two-pass": lambda wav, _: with_visemes(recognize(wav, method="words")),
+    "acoustic": lambda wav, _: with_visemes(recognize(wav, method="acoustic")),
     "default": lambda wav, _: facelib.visemes_from_audio(wav).speech,
 }
 

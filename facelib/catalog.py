@@ -18,9 +18,10 @@ from facelib.errors import DataError, FacelibError
 
 __all__ = ["KINDS", "Entry", "catalog"]
 
-KINDS = ("expressions", "visemes", "behaviours", "voices", "languages", "hair")
+KINDS = ("expressions", "visemes", "behaviours", "voices", "languages", "hair", "characters")
 
 EXPRESSION_GALLERY = "docs/images/expressions.png"
+CHARACTER_SHEET = "docs/images/characters.png"
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,7 +42,8 @@ def catalog(kind: str, *, lang: str | None = None) -> tuple[Entry, ...]:
         raise FacelibError(f"unknown kind {kind!r}; choose one of {', '.join(KINDS)}")
     listers: dict[str, Callable[[], tuple[Entry, ...]]] = {
         "expressions": _expressions, "visemes": _visemes, "behaviours": _behaviours,
-        "voices": _voices, "languages": _languages, "hair": _hair}
+        "voices": _voices, "languages": _languages, "hair": _hair,
+        "characters": _characters}
     entries = listers[kind]()
     if lang and kind == "voices":
         wanted = lang.lower()
@@ -108,3 +110,10 @@ def _hair() -> tuple[Entry, ...]:
     styles = data.json_data("head/hair_styles.json")["styles"]
     return tuple(Entry(name, "bald: no hair" if name == "none" else str(
         styles.get(name, {}).get("description", ""))) for name in hair_style_names())
+
+
+@cache
+def _characters() -> tuple[Entry, ...]:
+    from facelib.engine.characters import characters
+
+    return tuple(Entry(c.name, c.description, CHARACTER_SHEET) for c in characters())

@@ -27,6 +27,7 @@ __all__ = [
     "check_sample_rate",
     "check_seed",
     "did_you_mean",
+    "is_bare_name",
 ]
 
 T = TypeVar("T")
@@ -145,3 +146,9 @@ def did_you_mean(word: str, choices: Iterable[str], *, cutoff: float = 0.7) -> s
     options = {c.lower(): c for c in choices if c != word}
     close = difflib.get_close_matches(word.lower(), list(options), n=1, cutoff=cutoff)
     return f"; did you mean '{options[close[0]]}'?" if close else ""
+
+
+def is_bare_name(text: str) -> bool:
+    """Whether ``text`` reads as a name (a bundled character's, ``"ben"``) rather than a
+    file path: non-blank, without ``.``, ``/``, ``\\`` or a NUL."""
+    return bool(text.strip()) and not any(c in text for c in "./\\\0")

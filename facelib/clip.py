@@ -29,7 +29,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from facelib.checks import did_you_mean
-from facelib.errors import FdlError, ParameterError
+from facelib.errors import FaceModelError, FdlError, ParameterError
 from facelib.mpeg4.stream import FapStream
 
 __all__ = [
@@ -45,6 +45,7 @@ __all__ = [
     "make_clip",
     "make_scene_clip",
     "resolve_face",
+    "storyboard_definition",
     "styled_face",
 ]
 
@@ -162,11 +163,12 @@ FaceArg = Deformable | str | os.PathLike[str] | None
 
 
 def resolve_face(face: FaceArg) -> Deformable:
-    """``face``; a face definition JSON path loaded; None: facelib's bundled head."""
+    """``face``; a face definition JSON path or a bundled character's name (``"ben"``)
+    loaded; None: facelib's bundled head."""
     from facelib.engine import default_face, load_face
 
     if isinstance(face, (str, os.PathLike)):
-        return load_face(Path(face))
+        return load_face(face)
     return default_face() if face is None else face
 
 
@@ -210,7 +212,7 @@ def face_for(source: object, definition: str | os.PathLike[str] | None,
     if hair is None:
         return definition
     if definition is None:
-        definition = getattr(getattr(source, "storyboard", None), "face", None)
+        definition = storyboard_definition(getattr(source, "storyboard", None))
     return styled_face(definition, hair)
 
 
@@ -251,11 +253,26 @@ def make_clip(
     return clip
 
 
+def storyboard_definition(storyboard: object) -> Path | None:
+    """The face definition file a storyboard's ``face`` names (a path, or a bundled
+    character's name resolved by :func:`facelib.engine.characters.face_definition`), or
+    None; FdlError at the storyboard's ``face`` line for an unknown character."""
+    from facelib.engine.characters import face_definition
+
+    named = getattr(storyboard, "face", None)
+    try:
+        return face_definition(named)
+    except FaceModelError as exc:
+        lines = getattr(storyboard, "setting_lines", None) or {}
+        raise FdlError(exc.message, path=getattr(storyboard, "path", None) or "<storyboard>",
+                       line=lines.get("face")) from None
+
+
 def _storyboard_face(storyboard: object, *, use_face: bool,
                      use_hair: bool) -> Deformable | None:
     """The face a storyboard names (if ``use_face``) wearing its ``hair`` (if ``use_hair``),
     or None for the bundled head as it is."""
-    named = getattr(storyboard, "face", None) if use_face else None
+    named = storyboard_definition(storyboard) if use_face else None
     hair = getattr(storyboard, "hair", None) if use_hair else None
     if hair is None:
         return None if named is None else resolve_face(named)

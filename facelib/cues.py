@@ -149,8 +149,8 @@ class Character:
     """A character of a storyboard that names several (``characters { ada = {...} }``).
 
     name: what cues call it (``who = "ada"``).
-    face: the face definition it is played on, or None (the bundled head); a
-        :func:`facelib.clip.styled_face` definition.
+    face: the face definition it is played on, a bundled character's name (``"ada"``), or
+        None (the bundled head); a :func:`facelib.clip.styled_face` definition.
     hair: the hair style it wears, or None (the face definition's own).
     part: its own one-character storyboard: its speech, expressions, eye behaviours and
         moods, the shared definitions, its face and hair, no camera cues.
@@ -159,7 +159,7 @@ class Character:
 
     name: str
     part: Storyboard
-    face: Path | None = None
+    face: Path | str | None = None
     hair: str | None = None
     origin: Origin | None = None
 
@@ -187,11 +187,15 @@ class Storyboard:
         against its library and adds ``expression_defs[name]`` (FAP overrides) on top.
         Mixes of expressions the storyboard itself defines are resolved at load time.
     output: where the storyboard asks the ``.fap`` to go, or None.
-    face: the face definition JSON the storyboard is played on, or None (the default head).
+    face: the face definition JSON the storyboard is played on, a bundled character's name
+        (``face = "ben"``, a ``str``; resolved by
+        :func:`facelib.engine.characters.face_definition` when the face is loaded), or None
+        (the default head).
     hair: the hair style the face wears (``hair = "long"``; ``"none"``: bald), or None (the
         face definition's own); checked when the face is loaded (:func:`facelib.clip.make_clip`).
     setting_lines: the line of a setting the file sets, for errors found after loading
-        (``{"hair": 3}``: an unknown hair style is found when the face is loaded).
+        (``{"hair": 3}``: an unknown hair style is found when the face is loaded; ``face``
+        likewise for an unknown character).
     language: the storyboard's language (``language = "pt"``), used by speech that names
         none; None means English.
     camera: the camera cues, in time order (the renderer re-frames at each).
@@ -214,7 +218,7 @@ class Storyboard:
     gaze_defs: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     output: Path | None = None
     expression_mixes: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
-    face: Path | None = None
+    face: Path | str | None = None
     hair: str | None = None
     setting_lines: Mapping[str, int] = field(default_factory=dict)
     language: str | None = None

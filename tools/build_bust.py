@@ -91,14 +91,14 @@ def superellipse_radius(theta: np.ndarray, a: float, b: float, n: float) -> np.n
     return (np.power(s / a, n) + np.power(c / b, n)) ** (-1.0 / n)
 
 
-def ring_points(loop: np.ndarray) -> np.ndarray:
-    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``RINGS``."""
+def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
+    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``."""
     centre = np.array([0.0, 0.0, loop[:, 2].mean()])
     rel = loop - centre
     theta = np.arctan2(rel[:, 0], rel[:, 2])
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
     out = [loop]
-    for k, (y, tilt, a, b, n, ring_z) in enumerate(RINGS):
+    for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
         r = superellipse_radius(theta, a, b, n)
         zc = ring_z
         if k < len(LOOP_SHAPE):
@@ -132,11 +132,11 @@ def outward(vertices: np.ndarray, tris: np.ndarray) -> np.ndarray:
     return tris if np.einsum("ij,ij->", n, radial) > 0 else tris[:, ::-1].copy()
 
 
-def garment(spline: CubicSpline, theta: np.ndarray
+def garment(spline: CubicSpline, theta: np.ndarray, n_rings: int = len(RINGS)
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Garment vertices ``(G, 3)``, local triangles and a collar flag ``(G,)``."""
     start = NECKLINE[0] + NECKLINE[1] * np.clip(np.cos(theta), 0, None) ** 2
-    end = float(len(RINGS))
+    end = float(n_rings)
     tuck, rib, rib_h = COLLAR
     rows = [(start, tuck, True), (start, rib, True), (start + rib_h, rib, True)]
     rows.extend((start + rib_h + s ** 1.6 * (end - start - rib_h), GARMENT_OFFSET, False)
@@ -194,24 +194,34 @@ def bake_ao(head_v: np.ndarray, head_t: np.ndarray, bust_v: np.ndarray,
     return np.clip(ao, 0.0, 1.0)
 
 
-def build() -> tuple[dict[str, np.ndarray], np.ndarray]:
-    """The bust's arrays and the head's (possibly unfaded) vertex colours."""
-    doc = json.loads((HEAD / "default_head.json").read_text())
-    with np.load(HEAD / "default_head.npz") as data:
-        head_v, head_t = data["vertices"], data["triangles"]
-        head_c, head_ao = data["vertex_colors"], data["vertex_ao"]
-    skin = tuple(doc["parts"]["skin"])
-    head_c = unfade(head_c, head_v, skin)
+def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RINGS,
+          garment_rgb: np.ndarray = GARMENT_RGB, collar_rgb: np.ndarray = COLLAR_RGB
+          ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The bust's arrays and the head's (possibly unfaded) vertex colours. ``head``: the
+    head's ``vertices``, ``triangles``, ``vertex_colors``, ``vertex_ao`` and ``skin`` (its
+    vertex range), else the default head's; ``rings``: the cross-sections (``RINGS``);
+    the garment's and collar's sRGB colours (tools/build_characters.py varies all three)."""
+    given = head is not None
+    if head is None:
+        doc = json.loads((HEAD / "default_head.json").read_text())
+        with np.load(HEAD / "default_head.npz") as data:
+            head = {k: data[k] for k in ("vertices", "triangles", "vertex_colors", "vertex_ao")}
+        head["skin"] = np.array(doc["parts"]["skin"])
+    head_v, head_t = head["vertices"], head["triangles"]
+    head_c, head_ao = head["vertex_colors"], head["vertex_ao"]
+    skin = (int(head["skin"][0]), int(head["skin"][1]))
+    if not given:  # a given head's colours come from the default head's, unfaded
+        head_c = unfade(head_c, head_v, skin)
     loop_ids = seam_loop(head_v, head_t, skin)
     loop = head_v[loop_ids].astype(np.float64)
     theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
-    spline = surface(ring_points(loop))
+    spline = surface(ring_points(loop, rings))
     base, n_cols = len(head_v), len(loop_ids)
     skin_v = spline(SAMPLES).reshape(-1, 3)
     rows = np.vstack([loop_ids, base + np.arange(skin_v.shape[0]).reshape(len(SAMPLES), n_cols)])
     all_v = np.concatenate([head_v, skin_v])
     skin_t = outward(all_v, quads(rows))
-    g_v, g_t, collar = garment(spline, theta)
+    g_v, g_t, collar = garment(spline, theta, len(rings))
     start = base + len(skin_v)
     g_t = outward(np.concatenate([all_v, g_v]), g_t + start)
     vertices = np.concatenate([skin_v, g_v]).astype(np.float32)
@@ -220,7 +230,7 @@ def build() -> tuple[dict[str, np.ndarray], np.ndarray]:
     loop_rgb = head_c[loop_ids].astype(float)
     fall = np.clip(SAMPLES / 4.0, 0, 1)[:, None, None]
     skin_rgb = (1 - fall) * loop_rgb[None] + fall * loop_rgb.mean(0)
-    g_rgb = np.where(collar[:, None], COLLAR_RGB, GARMENT_RGB) * 255
+    g_rgb = np.where(collar[:, None], collar_rgb, garment_rgb) * 255
     colours = np.concatenate([skin_rgb.reshape(-1, 3), g_rgb])
     ao = bake_ao(head_v, head_t, vertices, triangles)
     # the head's own occlusion at the seam carries on down the neck, blending into the bake

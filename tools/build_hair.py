@@ -69,16 +69,23 @@ class Body:
         return p
 
 
-def load_head() -> dict:
-    doc = json.loads((HEAD / "default_head.json").read_text())
-    with np.load(HEAD / "default_head.npz") as data:
-        v, t, c = data["vertices"].astype(float), data["triangles"], data["vertex_colors"]
+def load_head(doc: dict | None = None, head: dict | None = None, bust: dict | None = None
+              ) -> dict:
+    """What grooming needs of a head: the default head and bust, or the face definition
+    ``doc``, head arrays ``head`` (``vertices``, ``triangles``, ``vertex_colors``) and bust
+    arrays ``bust`` (``vertices``, ``triangles``) given (tools/build_characters.py)."""
+    if doc is None or head is None or bust is None:
+        doc = json.loads((HEAD / "default_head.json").read_text())
+        with np.load(HEAD / "default_head.npz") as data:
+            head = {k: data[k] for k in data.files}
+        with np.load(HEAD / "default_bust.npz") as data:
+            bust = {k: data[k] for k in data.files}
+    v, t, c = head["vertices"].astype(float), head["triangles"], head["vertex_colors"]
     lo, hi = doc["parts"]["skin"]
     skin_t = t[(t >= lo).all(1) & (t < hi).all(1)]
     normals = vertex_normals(v, skin_t)
-    with np.load(HEAD / "default_bust.npz") as bust:
-        bv = bust["vertices"].astype(float)
-        bt = bust["triangles"]
+    bv = bust["vertices"].astype(float)
+    bt = bust["triangles"]
     allv = np.concatenate([v, bv])
     bn = vertex_normals(allv, bt)[len(v):]
     fp = doc["feature_points"]

@@ -12,13 +12,16 @@ from facelib.cli.options import COMMON
 from facelib.cli.outputs import STDOUT, check_suffix, emit_text
 from facelib.errors import FileError
 
+METHODS = ("auto", "acoustic", "words", "phones")
+"""``--recognize``'s choices: :data:`facelib.speech.recognize.METHODS`."""
+
 
 def add(commands: Any) -> None:
     align = commands.add_parser("align", help="align speech audio to visemes",
                                 parents=[COMMON])
     align.add_argument("audio", help="speech audio (any format soundfile reads)")
-    align.add_argument("--text", help="the transcript (omit it to recognise the speech: "
-                                      "English words, then the phone loop where none is heard)")
+    align.add_argument("--text", help="the transcript (omit it to recognise the speech: see "
+                                      "--recognize)")
     align.add_argument("--text-file", help="a file holding the transcript")
     align.add_argument("-o", "--output", required=True,
                        help="OUT.json, OUT.tsv or OUT.sb; - writes --format to stdout")
@@ -26,12 +29,14 @@ def add(commands: Any) -> None:
                        help="the format written to stdout by -o - (default json)")
     align.add_argument("--fps", type=float, default=25.0, help="frame rate of a .sb script")
     align.add_argument("--lang", default="en",
-                       help="language of the speech (en: pocketsphinx; others: DTW against "
-                            "espeak-ng, which needs --text)")
-    align.add_argument("--recognize", choices=("auto", "words", "phones"), default="auto",
-                       help="without --text: auto (words decoded then aligned, the phone "
-                            "loop where no word is heard), words (no fallback) or phones "
-                            "(the phone loop alone)")
+                       help="language of the speech (with --text, en: pocketsphinx, others: "
+                            "DTW against espeak-ng; without it, see --recognize)")
+    align.add_argument("--recognize", "--method", choices=METHODS, default="auto",
+                       help="without --text: auto (the best measured path for --lang: "
+                            "English words decoded then aligned, the phone loop where no word "
+                            "is heard; any other language the acoustic model), acoustic (the "
+                            "acoustic viseme model, any language), words (no fallback) or "
+                            "phones (the phone loop alone)")
     align.set_defaults(run=_align)
 
 

@@ -22,14 +22,15 @@ def add(commands: Any) -> None:
 
 def _check(args: argparse.Namespace, console: Console) -> int:
     from facelib.animation import animate, animate_scene
-    from facelib.clip import check_hair
+    from facelib.clip import check_hair, storyboard_definition
     from facelib.fdl import describe, load
 
     storyboard = load(args.story, seed=args.seed)
     parts = [c.part for c in storyboard.characters] or [storyboard]
     for part in parts:
+        definition = storyboard_definition(part)  # an unknown character, at its line
         if part.hair is not None:  # render would refuse it when it loads the face
-            check_hair(part.face, part.hair, path=args.story,
+            check_hair(definition, part.hair, path=args.story,
                        line=part.setting_lines.get("hair"))
     # what run rejects, check rejects
     if storyboard.characters:

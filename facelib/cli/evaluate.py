@@ -6,7 +6,7 @@ import argparse
 from typing import Any
 
 from facelib.cli.console import EXIT_OK, Console
-from facelib.cli.options import COMMON
+from facelib.cli.options import COMMON, FACE_HELP
 
 
 def add(commands: Any) -> None:
@@ -18,7 +18,7 @@ def add(commands: Any) -> None:
     evaluate.add_argument("--region", default="lips", help="region or group to switch")
     evaluate.add_argument("--poses", default="viseme,expression,syllable",
                           help="comma-separated pose kinds: viseme, expression, syllable")
-    evaluate.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    evaluate.add_argument("--face", help=f"{FACE_HELP} (default: the bundled head)")
     evaluate.add_argument("--stem", default="deformers", help="file name stem")
     evaluate.add_argument("--no-sheet", action="store_true", help="skip the mouth contact sheet")
     evaluate.set_defaults(run=_evaluate)

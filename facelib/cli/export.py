@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from facelib.cli.console import EXIT_OK, Console, UsageError
-from facelib.cli.options import COMMON, add_hair, output_face, read_source
+from facelib.cli.options import COMMON, FACE_HELP, add_hair, output_face, read_source
 from facelib.cli.outputs import check_suffix
 
 
@@ -30,7 +30,7 @@ def add(commands: Any) -> None:
     export.add_argument("--vrm", metavar="OUT.vrm",
                         help="also write a VRM 1.0 avatar of the head (expression presets aa ... "
                              "lookRight, humanoid, look-at; no animation)")
-    export.add_argument("--face", help="a face definition JSON (default: the bundled head)")
+    export.add_argument("--face", help=f"{FACE_HELP} (default: the bundled head)")
     add_hair(export)
     export.add_argument("--audio", help="speech audio to put beside the .glb / in the page")
     export.add_argument("--seed", type=int)

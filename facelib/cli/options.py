@@ -17,12 +17,22 @@ COMMON.add_argument("-v", "--verbose", action="store_true", default=argparse.SUP
                     help="also print log messages, progress of every stage and tracebacks")
 
 
+FACE_HELP = ("a bundled character (`facelib list characters`), a face definition JSON or a "
+             "`facelib face setup` folder")
+
+
 def face_path(face: str | None) -> Path | None:
-    """``--face``: a face definition JSON, or the folder ``facelib face setup`` wrote."""
-    if face is None:
-        return None
-    path = Path(face)
-    return path / "face.json" if path.is_dir() else path
+    """``--face``: a face definition JSON, the folder ``facelib face setup`` wrote, or a
+    bundled character's name (``--face ben``; `facelib list characters`), resolved by
+    :func:`facelib.engine.characters.face_definition`; UsageError, with a did-you-mean, for
+    an unknown name."""
+    from facelib.engine.characters import face_definition
+    from facelib.errors import FaceModelError
+
+    try:
+        return face_definition(face)
+    except FaceModelError as exc:
+        raise UsageError(f"--face: {exc.message}") from None
 
 
 def add_hair(command: argparse.ArgumentParser) -> None:

@@ -12,6 +12,7 @@ from typing import Any
 from facelib.cli.console import EXIT_ERROR, EXIT_OK, Console, UsageError
 from facelib.cli.options import (
     COMMON,
+    FACE_HELP,
     add_hair,
     character_file,
     face_path,
@@ -28,8 +29,8 @@ def _add_render_options(command: argparse.ArgumentParser, *, batch: bool) -> Non
                 + ("; with several sources or -j, the folder for STEM.mp4 files" if batch
                    else ""))
     command.add_argument("-o", "--output", required=not batch, help=help_out)
-    command.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
-                         "folder (default: the storyboard's face, else the bundled head)")
+    command.add_argument("--face", help=f"{FACE_HELP} (default: the storyboard's face, else "
+                         "the bundled head)")
     add_hair(command)
     command.add_argument("--width", type=int, default=640)
     command.add_argument("--height", type=int, default=480)

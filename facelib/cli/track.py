@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from facelib.cli.console import EXIT_OK, Console
-from facelib.cli.options import COMMON, chosen_face
+from facelib.cli.options import COMMON, FACE_HELP, chosen_face
 from facelib.cli.outputs import check_suffix, emit_text
 from facelib.errors import FacelibError
 from facelib.mpeg4 import format_fap
@@ -48,7 +48,7 @@ def add(commands: Any) -> None:
                        help="the .fap file to write, or - for stdout")
     track.add_argument("--landmarks-out", help="also write the landmarks as CSV")
     track.add_argument("--render", help="also write the Virtual Mirror video (source | avatar)")
-    track.add_argument("--face", help="the avatar's face definition (default: bundled head)")
+    track.add_argument("--face", help=f"the avatar: {FACE_HELP} (default: bundled head)")
     track.add_argument("--show-landmarks", action="store_true",
                        help="draw the tracked landmarks on the mirror's source side")
     track.add_argument("--neutral", help="neutral frame N or span START:STOP (default: the "

@@ -6,7 +6,7 @@ import argparse
 from typing import Any
 
 from facelib.cli.console import EXIT_OK, Console
-from facelib.cli.options import COMMON, add_hair, output_face, read_source
+from facelib.cli.options import COMMON, FACE_HELP, add_hair, output_face, read_source
 
 
 def add(commands: Any) -> None:
@@ -14,8 +14,8 @@ def add(commands: Any) -> None:
         "view", parents=[COMMON],
         help="play a .fap or storyboard in a window (space: pause, arrows: step, q: quit)")
     view.add_argument("source", help="STORY.fdl or FILE.fap")
-    view.add_argument("--face", help="a face definition JSON or a `facelib face setup` "
-                      "folder (default: the storyboard's face, else the bundled head)")
+    view.add_argument("--face", help=f"{FACE_HELP} (default: the storyboard's face, else the "
+                      "bundled head)")
     add_hair(view)
     view.add_argument("--loop", action="store_true", help="replay until the window is closed")
     view.add_argument("--mute", action="store_true", help="do not play the speech audio")

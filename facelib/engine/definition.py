@@ -8,6 +8,7 @@ or float 0-1).
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from types import MappingProxyType
@@ -17,6 +18,7 @@ import numpy as np
 
 from facelib import data
 from facelib.engine.attachments import attach, definition_hair_styles, read_attachments
+from facelib.engine.characters import face_definition
 from facelib.engine.deformers import ALIASES, Deformer, deformer, deformer_names
 from facelib.engine.face import (
     ATTACHED_PARTS,
@@ -65,14 +67,18 @@ Override = str | Deformer | Mapping[str, Any]
 
 
 def load_face(
-    path: str | Path | None = None, *, deformers: Mapping[str, Override] | None = None,
+    path: str | os.PathLike[str] | None = None, *, deformers: Mapping[str, Override] | None = None,
     hair: str | None = None,
 ) -> Face:
     """Load a face definition and its mesh, validate them and compile the deformers.
 
     Parameters
     ----------
-    path: the JSON face definition; None loads facelib's default head (metres).
+    path: the JSON face definition, the name of a bundled character (``"ben"``,
+        :func:`~facelib.engine.characters.character_names`) or the folder ``facelib face
+        setup`` wrote; None loads facelib's default head (metres). Resolved by
+        :func:`~facelib.engine.characters.face_definition` (FaceModelError with a
+        did-you-mean for an unknown character name).
     deformers: overrides of the definition's deformers, keyed by region name or group
         (``{"lips": "inverse_distance", "brow_l": {"deformer": "rbf", "kernel": "gaussian"}}``);
         a region name wins over its group. A bare name keeps no parameters of the
@@ -86,19 +92,37 @@ def load_face(
         indices, empty regions, unknown deformers or pivots; the message names the item.
     ParameterError: an override key that names no region or group.
     """
-    path = _default_path() if path is None else Path(path)
-    return _Reader(path, _read_definition(path), dict(deformers or {}), hair).face()
+    path = face_definition(path) or _default_path()
+    return _Reader(path, _definition(path), dict(deformers or {}), hair).face()
 
 
-def hair_style_names(path: str | Path | None = None) -> tuple[str, ...]:
+def hair_style_names(path: str | os.PathLike[str] | None = None) -> tuple[str, ...]:
     """The hair styles the face definition at ``path`` (None: the default head) may wear,
     as ``load_face(path, hair=...)`` takes them: its hair mesh's styles, then ``"none"``.
     FaceModelError for an unreadable definition or hair mesh."""
-    path = _default_path() if path is None else Path(path)
-    doc = _read_definition(path)
+    path = face_definition(path) or _default_path()
+    doc = _definition(path)
     if not isinstance(doc, dict):
         raise FaceModelError("a face definition is a JSON object", path=path)
     return definition_hair_styles(path, doc)
+
+
+def _definition(path: Path) -> Any:
+    """The face definition at ``path`` with what it ``extends`` filled in: a definition
+    may name another beside it (``"extends": "default_head.json"``, which must not extend
+    a third) whose entries it takes for every key it does not give itself."""
+    doc = _read_definition(path)
+    if not isinstance(doc, dict) or "extends" not in doc:
+        return doc
+    name = doc["extends"]
+    if not isinstance(name, str):
+        raise FaceModelError(f"'extends' must be a file name, not {name!r}", path=path)
+    base_path = mesh_path(path, name)
+    base = _read_definition(base_path)
+    if not isinstance(base, dict) or "extends" in base:
+        raise FaceModelError(f"'extends' names {name!r}, which must be a face definition "
+                             "that extends no other", path=path)
+    return {**base, **{k: v for k, v in doc.items() if k != "extends"}}
 
 
 def _read_definition(path: Path) -> Any:
@@ -188,8 +212,15 @@ class _Reader:
             raise self.fail(exc.message) from exc
 
     def mesh(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        mesh_file = mesh_path(self.path, self.get("mesh", str))
-        data = read_npz(mesh_file)
+        names = self.get("mesh", (str, list))
+        names = [names] if isinstance(names, str) else names
+        if not names or not all(isinstance(n, str) for n in names):
+            raise self.fail(f"'mesh' must be a file name or a non-empty list of them, not "
+                            f"{names!r}")
+        data: dict[str, np.ndarray] = {}
+        for name in names:  # a later file's arrays replace an earlier one's
+            data.update(read_npz(mesh_path(self.path, name)))
+        mesh_file = mesh_path(self.path, names[-1])
         missing = [k for k in ("vertices", "triangles", "vertex_colors") if k not in data]
         if missing:
             raise self.fail(f"mesh {mesh_file.name!r} lacks the array {missing[0]!r}")

@@ -97,7 +97,8 @@ SETTINGS: Mapping[str, str] = MappingProxyType({
     "fps": "frames per second of the animation (default 25)",
     "seed": "seed of every random process (default 0)",
     "output": 'the .fap file to write, relative to the storyboard, or "none"',
-    "face": "the face definition JSON to play on, relative to the storyboard "
+    "face": "a bundled character's name (`facelib list characters`) or the face "
+            "definition JSON to play on, relative to the storyboard "
             "(e.g. made by facelib face setup; default: the bundled head)",
     "hair": 'the hair style the face wears ("short", "long", "tied", "none": bald; '
             "default: the face definition's)",

@@ -4,9 +4,10 @@ One file may use the thesis's format (``FDL = {...}`` naming ``.sb`` sub-scripts
 ``expressions`` / ``eyes`` / ``Sentence`` lists themselves), the modern storyboard functions
 (``say``, ``show``, ``look``, ``define_expression``, ``define_gaze``), or both. Globals
 ``fps`` (default 25), ``seed`` (default 0), ``output``, ``face`` (a face definition JSON,
-e.g. one made by ``facelib face setup``), ``hair`` (a hair style of that face; checked
-against the face's styles when the face is loaded) and ``language`` (default English; the
-language of speech that names none) set the storyboard options; every name is declared in
+e.g. one made by ``facelib face setup``, or a bundled character's name: ``face = "ben"``),
+``hair`` (a hair style of that face; checked against the face's styles when the face is
+loaded) and ``language`` (default English; the language of speech that names none) set the
+storyboard options; every name is declared in
 :mod:`facelib.fdl.functions`. Each syntax converts to cues in its own module
 (:mod:`~facelib.fdl.thesis_cues`, :mod:`~facelib.fdl.modern_cues`); this module runs the
 script, reads the settings and merges the two.
@@ -21,7 +22,7 @@ import warnings
 from pathlib import Path
 from typing import TypeVar
 
-from facelib.checks import did_you_mean
+from facelib.checks import did_you_mean, is_bare_name
 from facelib.cues import Character, ExpressionCue, GazeCue, SpeechSpec, Storyboard
 from facelib.errors import FdlError, FdlWarning, ParameterError
 from facelib.fdl import modern_cues, thesis_cues
@@ -220,9 +221,11 @@ def _build(
     if output is not None:
         _check_output(output, inputs=(file, *_inputs_of(speech)), ctx=ctx)
     face_value = _global(chunk, "face")
+    face_line = _line(text, "face")
     face = (None if face_value is None
-            else _face_file(face_value, ctx, what="face", line=_line(text, "face")))
+            else _face_file(face_value, ctx, what="face", line=face_line))
     hair, lines = _hair(chunk, text, name)
+    lines = {**lines, **({} if face is None or face_line is None else {"face": face_line})}
     return Storyboard(
         path=file,
         fps=fps,
@@ -244,9 +247,15 @@ def _build(
     )
 
 
-def _face_file(value: object, ctx: Context, *, what: str, line: int | None) -> Path:
+def _face_file(value: object, ctx: Context, *, what: str, line: int | None) -> Path | str:
     """The face definition a storyboard names (``face = ...``, a character's ``face``):
-    a file inside the storyboard's folder, played through :func:`facelib.clip.styled_face`."""
+    a file inside the storyboard's folder, played through :func:`facelib.clip.styled_face`;
+    or a bundled character's name (a bare word naming no file there: ``face = "ben"``), kept
+    as the string and resolved, with a did-you-mean at this line, when the face is loaded
+    (:func:`facelib.clip.storyboard_definition`)."""
+    if (isinstance(value, str) and is_bare_name(value)
+            and (ctx.base_dir is None or not (ctx.base_dir / value).exists())):
+        return value
     return resolve_inside(ctx.base_dir, value, what=what, path=ctx.path, line=line)
 
 
@@ -286,8 +295,8 @@ def _cast(
             gaze=_by_start(modern_cues.gaze_cues(own.gaze, ctx)),
             expression_defs=parts.expression_defs, gaze_defs=parts.gaze_defs,
             expression_mixes=parts.expression_mixes, face=face, hair=draft.hair,
-            setting_lines={} if draft.hair is None or draft.line is None
-            else {"hair": draft.line},
+            setting_lines={} if draft.line is None else {
+                k: draft.line for k, v in (("hair", draft.hair), ("face", face)) if v},
             moods=mood_cues(own.moods, ctx))
         characters.append(Character(draft.name, part, face=face, hair=draft.hair,
                                     origin=ctx.origin(draft.line)))

@@ -1,5 +1,8 @@
-"""Visemes of speech audio as it streams in: pocketsphinx's phone loop (the audio-only path
-of ``facelib align``) decoding chunk by chunk, the partial phone segmentation read after each.
+"""Visemes of speech audio as it streams in, chunk by chunk: the acoustic viseme model
+(``method="acoustic"``, any language: :class:`facelib.speech.acoustic.
+AcousticStream`, each frame decided a fixed look-ahead after it, the undecided end held at
+the last viseme decided) or pocketsphinx's phone loop (``method="phones"``, English: its
+partial phone segmentation read after each chunk).
 
 A stretch of audio is one recognizer utterance; it ends (and the recognizer's memory with it)
 once it is longer than ``MAX_STRETCH_MS`` and its last ``QUIET_MS`` are quiet, or at
@@ -8,11 +11,12 @@ once it is longer than ``MAX_STRETCH_MS`` and its last ``QUIET_MS`` are quiet, o
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from facelib.errors import ParameterError
+from facelib.speech.acoustic import AcousticStream, classes_to_spans, load_model
 from facelib.speech.audio import ALIGN_RATE, to_pcm16
 from facelib.speech.decoding import NOISE, PHONE_LOOP, new_decoder
 from facelib.speech.loudness import window_loudness
@@ -22,8 +26,11 @@ from facelib.visemes.animate import SpeechAudio
 from facelib.visemes.mapping import with_visemes
 from facelib.visemes.timeline import SpeechTimeline
 
-__all__ = ["HARD_STRETCH_MS", "MAX_CHUNK_SAMPLES", "MAX_STRETCH_MS", "QUIET_MS", "Listener",
-           "pcm16_samples"]
+__all__ = ["HARD_STRETCH_MS", "LISTEN_METHODS", "MAX_CHUNK_SAMPLES", "MAX_STRETCH_MS",
+           "QUIET_MS", "ListenMethod", "Listener", "pcm16_samples"]
+
+ListenMethod = Literal["acoustic", "phones"]
+LISTEN_METHODS = ("acoustic", "phones")
 
 MAX_STRETCH_MS = 8_000
 HARD_STRETCH_MS = 30_000
@@ -42,9 +49,15 @@ def pcm16_samples(pcm: bytes) -> np.ndarray:
 
 
 class Listener:
-    """One stretch of streamed 16 kHz speech and its partial phone timeline."""
+    """One stretch of streamed 16 kHz speech and its partial phone timeline, recognised by
+    ``method`` (``"acoustic"`` or ``"phones"``)."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, method: ListenMethod = "acoustic") -> None:
+        if method not in LISTEN_METHODS:
+            raise ParameterError(f"listen must be one of {', '.join(LISTEN_METHODS)}, "
+                                 f"not {method!r}")
+        self.method = method
+        self._stream: AcousticStream | None = None
         self._decoder: Any = None
         self._chunks: list[np.ndarray] = []
         self._open = False  # an utterance is started
@@ -56,7 +69,12 @@ class Listener:
 
     def prepare(self) -> None:
         """Load the recognizer (about 0.6 s and 90 MB) and open the next stretch's utterance
-        (its leading pad decoded) now, rather than at the first samples."""
+        (its leading pad decoded) now, rather than at the first samples; for the acoustic
+        model, load it (a few ms) and start the stretch's stream."""
+        if self.method == "acoustic":
+            if self._stream is None:
+                self._stream = AcousticStream(load_model())
+            return
         if self._decoder is None:
             decoder = new_decoder()
             decoder.activate_search(PHONE_LOOP)
@@ -75,12 +93,28 @@ class Listener:
         self.prepare()
         self._chunks.append(np.asarray(samples, np.float32))
         self.n_samples += samples.size
+        if self._stream is not None:
+            self._stream.feed(samples)
+            audio = np.concatenate(self._chunks)
+            self._chunks = [audio]
+            return self._acoustic_timeline(), SpeechAudio(audio, ALIGN_RATE)
         pcm = np.clip(np.round(samples.astype(np.float64) * 32767), -32768, 32767)
         self._decoder.process_raw(pcm.astype("<i2").tobytes(), no_search=False,
                                   full_utt=False)
         audio = np.concatenate(self._chunks)
         self._chunks = [audio]
         return self._timeline(), SpeechAudio(audio, ALIGN_RATE)
+
+    def _acoustic_timeline(self) -> SpeechTimeline:
+        assert self._stream is not None
+        duration = self.duration_ms
+        classes = self._stream.classes
+        # frames not yet decided hold the last decided viseme (they may still change)
+        held = classes + [classes[-1] if classes else 0] * max(
+            -(-duration // 10) - len(classes), 0)
+        phones = classes_to_spans(held, self._stream.model.labels, duration) or (
+            Span(SILENCE, 0, duration),)
+        return with_visemes(PhoneTimeline(phones, (), "acoustic", duration, alphabet="ipa"))
 
     def _timeline(self) -> SpeechTimeline:
         settings = alignment_settings()
@@ -112,5 +146,6 @@ class Listener:
         if self._open:
             self._decoder.end_utt()
             self._open = False
+        self._stream = None
         self._chunks = []
         self.n_samples = 0

@@ -44,9 +44,9 @@ HARD_MESSAGE_BYTES = 1024 * 1024
 """Largest message the WebSocket layer accepts at all (it closes the connection, code 1009)."""
 _OUTPUTS = {"faps", "arkit", "visemes"}
 _SESSION_KEYS = ("fps", "lookahead_ms", "seed", "lang", "voice", "rate", "clock", "face",
-                 "audio_in", "subject")
+                 "audio_in", "subject", "listen")
 _START_KEYS = {"type", "token", "fps", "lookahead_ms", "seed", "lang", "voice", "rate",
-               "outputs", "clock", "face", "audio_in", "livelink", "vmc", "subject"}
+               "outputs", "clock", "face", "audio_in", "livelink", "vmc", "subject", "listen"}
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ from facelib.cues import SpeechSpec
 from facelib.errors import MissingExtraError, ParameterError
 from facelib.live.engine import Engine, Frame
 from facelib.live.inputs import Cues, cues_from_fdl, cues_from_json, split_sentences
-from facelib.live.listen import Listener, pcm16_samples
+from facelib.live.listen import Listener, ListenMethod, pcm16_samples
 from facelib.live.plan import Plan, Window, window
 from facelib.live.udp import UdpTarget, parse_target
 from facelib.speech.espeak import Worker
@@ -81,7 +81,10 @@ class Session:
     0.6 s in a thread, 90 MB) instead of holding up the first chunk; livelink / vmc:
     ``"HOST:PORT"`` to send each frame to as a Live Link Face packet
     (:mod:`facelib.live.livelink`, port 11111 if left out) or a VMC bundle
-    (:mod:`facelib.live.vmc`, port 39539); subject: the Live Link subject name.
+    (:mod:`facelib.live.vmc`, port 39539); subject: the Live Link subject name; listen:
+    how audio sent in is recognised: ``"acoustic"`` (the acoustic viseme model, any
+    language; the default for every ``lang`` but English) or ``"phones"`` (pocketsphinx's
+    phone loop, English; the default for English, where it measured better).
     """
 
     def __init__(self, *, face: object | None = None, fps: float = 30.0,
@@ -89,7 +92,8 @@ class Session:
                  voice: str | None = None, rate: float = 1.0, arkit: bool = False,
                  clock: Literal["wall", "manual"] = "wall", epoch_s: float = 60.0,
                  queue_s: float = 5.0, audio_in: bool = False, livelink: str | None = None,
-                 vmc: str | None = None, subject: str = "facelib") -> None:
+                 vmc: str | None = None, subject: str = "facelib",
+                 listen: ListenMethod | None = None) -> None:
         if clock not in ("wall", "manual"):
             raise ParameterError(f"clock must be 'wall' or 'manual', got {clock!r}")
         if face is not None:
@@ -102,7 +106,8 @@ class Session:
         self.udp = _targets(livelink, vmc)
         self.subject = subject
         self._text = ""
-        self._listener = Listener()
+        english = lang.lower().startswith("en")
+        self._listener = Listener(method=listen or ("phones" if english else "acoustic"))
         self._audio_next_ms: int | None = None  # session ms where the next audio sample goes
         self._queue = _Queue(asyncio.Queue(maxsize=max(1, round(queue_s * fps))))
         self._sentences: asyncio.Queue[tuple[str, int | None]] = asyncio.Queue()
@@ -199,7 +204,8 @@ class Session:
 
     async def audio(self, pcm: bytes | np.ndarray) -> None:
         """Add speech audio: 16-bit little-endian PCM bytes or ``(n,) float`` samples, mono
-        16 kHz. Its visemes come from the phone loop, its loudness opens the jaw."""
+        16 kHz. Its visemes come from the session's ``listen`` method (the acoustic viseme
+        model, any language, or the phone loop), its loudness opens the jaw."""
         samples = pcm16_samples(pcm) if isinstance(pcm, bytes) else np.asarray(
             pcm, np.float32).reshape(-1)
         if samples.size == 0:

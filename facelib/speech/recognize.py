@@ -27,20 +27,36 @@ from facelib.speech.decoding import decode, forced, phone_loop, tokenize_words
 from facelib.speech.tables import alignment_settings, recognition_settings
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Source, Span, append_span, cover
 
-__all__ = ["Method", "decode_words", "recognizable_languages", "recognize"]
+__all__ = ["METHODS", "Method", "auto_method", "decode_words", "recognizable_languages",
+           "recognize"]
 
-Method = Literal["auto", "words", "phones"]
-"""How speech without a transcript is recognised: ``"auto"`` (words, then the phone loop
-where no word is heard), ``"words"`` (the two passes alone), ``"phones"`` (the phone loop)."""
+Method = Literal["auto", "words", "phones", "acoustic"]
+"""How speech without a transcript is recognised: ``"auto"`` (the best path measured for the
+language: ``recognition.json``'s ``auto``), ``"words"`` (the two passes alone),
+``"phones"`` (the phone loop), ``"acoustic"`` (the project's acoustic viseme model,
+:mod:`facelib.speech.acoustic`: any language, numpy only)."""
+METHODS = ("auto", "words", "phones", "acoustic")
 _FILLERS = {"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]", "[BREATH]", "[COUGH]", "[LAUGH]",
             "[UM]", "[UH]", "[SMACK]"}
 
 
 def recognizable_languages(method: Method = "auto") -> tuple[str, ...]:
-    """The languages (ISO 639-1) that ``method`` recognises without a transcript."""
+    """The languages (ISO 639-1) that ``method`` recognises without a transcript; ``("*",)``
+    for every language (``"acoustic"``, and so ``"auto"``)."""
     settings = recognition_settings()
+    if method in ("acoustic", "auto"):
+        return ("*",)
     key = "phone_loop_languages" if method == "phones" else "word_languages"
     return tuple(settings[key])
+
+
+def auto_method(language: str) -> Method:
+    """The method ``"auto"`` takes for ``language``: ``recognition.json``'s ``auto`` entry
+    for it (the path that measured best), else its ``"*"`` entry."""
+    table = recognition_settings()["auto"]
+    code = language.lower().replace("_", "-").split("-")[0]
+    method: Method = table.get(code, table["*"])
+    return method
 
 
 def recognize(
@@ -49,23 +65,35 @@ def recognize(
 ) -> PhoneTimeline:
     """Phones and words of speech ``audio`` without its transcript.
 
-    ``method="auto"`` (the default): words decoded, then aligned (``source="recognized"``,
-    each word's ``confidence`` in [0, 1]); a recording where no word is heard goes to the
-    phone loop (``source="phone-loop"``, no words). ``"words"`` raises instead of falling
-    back; ``"phones"`` takes the phone loop at once. Recordings over ``piece_ms`` are
-    recognised in pieces cut at their quietest moments (a piece without words takes the
-    phone loop alone; the timeline's ``source`` is then that of most of its time).
+    ``method="auto"`` (the default) takes the path that measured best for ``language``
+    (:func:`auto_method`: ``recognition.json``'s ``auto``). ``"acoustic"``: the acoustic
+    viseme model, any language (``source="acoustic"``, IPA phones standing for their
+    visemes, no words). ``"words"``: words decoded, then aligned
+    (``source="recognized"``, each word's ``confidence`` in [0, 1]); under ``"auto"`` a
+    recording where no word is heard goes to the phone loop (``source="phone-loop"``, no
+    words), ``"words"`` alone raises instead. ``"phones"`` takes the phone loop at once.
+    Recordings over ``piece_ms`` are recognised in pieces cut at their quietest moments (a
+    piece without words takes the phone loop alone; the timeline's ``source`` is then that
+    of most of its time).
 
-    ``language``: only English has models (``recognition.json``); any other language raises
-    :class:`SpeechError` naming it and saying to give the transcript.
+    ``language``: ``"words"`` and ``"phones"`` have English models only
+    (``recognition.json``); another language raises :class:`SpeechError` naming it.
 
     Raises SpeechError (unreadable or silent audio, no speech heard, a language without a
     model), ParameterError (an unknown ``method``), MissingExtraError (no pocketsphinx).
     """
-    if method not in ("auto", "words", "phones"):
-        raise ParameterError(f"method must be auto, words or phones, not {method!r}")
+    if method not in METHODS:
+        raise ParameterError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
+    if method == "acoustic" or (method == "auto" and auto_method(language) == "acoustic"):
+        from facelib.speech.acoustic import recognize_acoustic
+
+        heard = recognize_acoustic(audio, sample_rate=sample_rate)
+        if all(s.label == SILENCE for s in heard.phones):
+            raise SpeechError("no speech recognised in the audio",
+                              path=None if isinstance(audio, np.ndarray) else audio)
+        return heard
     code = language.lower().replace("_", "-").split("-")[0]
-    if code not in recognizable_languages(method):
+    if code not in recognizable_languages(method) and method != "auto":
         known = ", ".join(recognizable_languages(method))
         raise SpeechError(
             f"speech in {language!r} needs its transcript (text): there is no recogniser "

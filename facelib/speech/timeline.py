@@ -17,7 +17,7 @@ SILENCE = "SIL"
 """The phone label of silence (and of the acoustic model's noise phones after cleaning)."""
 
 Source = Literal["forced", "recognized", "phone-loop", "durations", "script", "synthesis",
-                 "dtw"]
+                 "dtw", "acoustic"]
 Alphabet = Literal["arpabet", "ipa"]
 """How phone labels are written: ARPAbet (pocketsphinx, the duration model) or IPA
 (espeak-ng synthesis and the alignment built on it)."""
@@ -55,7 +55,8 @@ class PhoneTimeline:
     (``source``: ``"forced"`` alignment, ``"phone-loop"`` recognition, ``"durations"`` of the
     text-only model, ``"synthesis"`` by espeak-ng, ``"dtw"`` alignment to a synthesized
     transcript, ``"recognized"``: words recognised in audio without a transcript, then
-    aligned), ``duration_ms``, the length of the speech, and ``alphabet``, how the phone
+    aligned; ``"acoustic"``: the acoustic viseme model, phones standing for their visemes),
+    ``duration_ms``, the length of the speech, and ``alphabet``, how the phone
     labels are written (``"arpabet"`` or ``"ipa"``)."""
 
     phones: tuple[Span, ...]

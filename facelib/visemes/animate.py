@@ -110,7 +110,8 @@ def speech_timeline(speech: SpeechSpec, *, rate: float = 1.0,
     """The timeline of ``speech`` in its own time (ms from ``speech.start_ms``): a stored
     viseme script as it is; audio and text by forced alignment (English: pocketsphinx,
     falling back to DTW; other languages: DTW against espeak-ng); audio alone by
-    recognition (English words, then the phone loop; see
+    recognition (English words, then the phone loop; other languages the acoustic viseme
+    model; see
     :func:`facelib.speech.recognize.recognize`); text alone synthesized by espeak-ng. ``rate``
     multiplies ``speech.rate``; ``language`` is the storyboard's (``speech.lang`` wins)."""
     return _spoken(speech, rate=rate, language=language)[0]
@@ -156,8 +157,9 @@ def _spoken(speech: SpeechSpec, *, rate: float, language: str | None,
 def _recorded(audio: Path, text: str | None, lang: str, voice: str | None) -> PhoneTimeline:
     """Phones of recorded ``audio``: with a transcript, pocketsphinx for English (DTW if it
     fails) and DTW against the synthesized transcript for any other language; without one,
-    recognition (:func:`facelib.speech.recognize.recognize`: English words, then the phone
-    loop; a clear SpeechError for a language without a model)."""
+    recognition (:func:`facelib.speech.recognize.recognize`, the best measured path for the
+    language: English words, then the phone loop; any other language the acoustic viseme
+    model)."""
     if text is None:
         return recognize(audio, language=lang)
     if lang.lower().startswith("en"):

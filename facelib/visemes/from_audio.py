@@ -32,13 +32,14 @@ def visemes_from_audio(
         A sound file in any format soundfile reads, or an array ``(n,)`` or
         ``(n, channels)`` of samples (then give ``sample_rate`` in Hz).
     language:
-        The speech's language. English is recognised (words decoded, then aligned; where
-        no word is heard, the phone loop); another language raises :class:`SpeechError`
-        naming it (give the transcript to ``facelib.visemes.align_dtw`` instead).
+        The speech's language, any: ``method="auto"`` takes the path that measures best
+        for it (English: words decoded, then aligned, the phone loop where no word is
+        heard; every other language: the acoustic viseme model).
     fps:
         Frame rate of the track.
     method:
-        ``"auto"``, ``"words"`` or ``"phones"``, as :func:`facelib.speech.recognize.recognize`.
+        ``"auto"``, ``"acoustic"`` (any language), ``"words"`` or ``"phones"`` (English),
+        as :func:`facelib.speech.recognize.recognize`.
     style:
         Articulation, as a ``say``'s ``style``.
 

@@ -139,3 +139,31 @@ def test_windows_computed_ahead_on_the_wall_clock_give_the_same_frames() -> None
     alone = Engine(fps=30, seed=4).advance(100 * 1000 / 30)
     assert [o.frame.index for o in live] == list(range(100))
     assert all(np.array_equal(o.frame.faps, f.faps) for o, f in zip(live, alone, strict=True))
+
+
+def test_streamed_audio_in_any_language_takes_the_acoustic_model() -> None:
+    """The listener's acoustic stream decides each frame as the offline model does, and a
+    session hears Italian audio (no transcript, no English model) with its closures."""
+    from facelib.live.listen import Listener
+    from facelib.speech import synthesize
+    from facelib.speech.acoustic import frame_classes
+    from facelib.speech.audio import load_speech
+
+    made = synthesize("Mamma, il babbo porta la mela.", lang="it")
+    pcm = load_speech(made.samples, sample_rate=made.sample_rate)
+    listener = Listener(method="acoustic")
+    for k in range(0, pcm.size, 1600):
+        timeline, _ = listener.feed(pcm[k:k + 1600])
+    assert timeline.source == "acoustic" and timeline.duration_ms == pcm.size // 16
+    decided = listener._stream.classes  # what the stream has decided
+    assert decided == frame_classes(pcm)[:len(decided)].tolist()
+    assert len(decided) >= pcm.size // 160 - 12  # at most the look-ahead undecided
+    assert any(v.is_bilabial for v in timeline.visemes)
+    with SyncSession(clock="manual", lookahead_ms=100, lang="it") as s:
+        for k in range(0, pcm.size, 1600):
+            s.audio((pcm[k:k + 1600] * 32767).astype("<i2").tobytes())
+        s.stop()
+        frames = list(s.frames())
+    assert any(o.frame.viseme == 1 for o in frames)
+    with pytest.raises(ParameterError, match="listen"):
+        Listener(method="words")  # type: ignore[arg-type]

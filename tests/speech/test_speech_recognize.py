@@ -84,11 +84,16 @@ def test_phone_loop_takes_over_when_no_word_is_heard():
     assert loop.source == "phone-loop" and loop.words == ()
 
 
-def test_other_languages_need_their_transcript():
+def test_other_languages_take_the_acoustic_model():
+    """pocketsphinx's paths know English only; ``auto`` hears any other language with the
+    acoustic viseme model."""
     with pytest.raises(SpeechError, match=r"speech in 'es' needs its transcript.*knows en"):
-        recognize(FIXTURES / "quick_fox.flac", language="es")
+        recognize(FIXTURES / "quick_fox.flac", language="es", method="words")
     with pytest.raises(SpeechError, match="'de'"):
-        facelib.visemes_from_audio(FIXTURES / "quick_fox.flac", language="de")
+        facelib.visemes_from_audio(FIXTURES / "quick_fox.flac", language="de", method="phones")
+    heard = facelib.visemes_from_audio(FIXTURES / "quick_fox.flac", language="de")
+    assert heard.speech.source == "acoustic" and heard.speech.alphabet == "ipa"
+    assert any(v.is_bilabial for v in heard.timeline)
 
 
 def test_visemes_from_audio_array_is_the_storyboard_path():
