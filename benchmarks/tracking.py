@@ -19,6 +19,10 @@ model has seen; the stylised cartoon head with head turns; last
 ``examples/tracking/expressive.fdl`` (speech with surprise, worry, sadness, fear and anger,
 which move the brows visibly, and gaze) with head turns on the default head, as scripted on
 it, and with head turns on the SOMA-X and cartoon heads.
+Then (issue 37) the speed of the whole video path against MediaPipe's own on the same frames
+(CPU time, ``video_speed``) and, per head (default, cartoon, SOMA-X), the probe stream
+(``closedloop.probe_stream``) judged by the spread rule with confidence intervals
+(``probe_report``, :mod:`facelib.tracking.agreement`).
 Lip closures: the p/b/m closures of the truth (its inner-lip gap under 0.1 MNS0 during a
 bilabial viseme of the storyboard) during which the avatar's lips also touch, those after
 and before which they also part again (a closure held across several does not count); the
@@ -29,6 +33,7 @@ touch where the source's do not).
 
 from __future__ import annotations
 
+import os
 import tempfile
 import time
 import tracemalloc
@@ -39,7 +44,8 @@ import numpy as np
 
 import facelib
 from facelib.engine import Face, default_face
-from facelib.mpeg4 import FapStream
+from facelib.mpeg4 import ANGLE_UNIT, FapStream
+from facelib.tracking.agreement import agreement
 from facelib.tracking.browimage import track_brows
 from facelib.tracking.closedloop import (
     ClosedLoop,
@@ -53,7 +59,10 @@ from facelib.tracking.closedloop import (
     false_closures,
     lip_closures,
     lip_gap,
+    probe_stream,
+    still_face,
     with_head_turns,
+    with_neutral_lead,
 )
 from facelib.tracking.faps import measure_faps
 from facelib.tracking.files import read_landmarks, write_landmarks_csv
@@ -136,6 +145,73 @@ def speed(frames: np.ndarray, landmarks: np.ndarray, fps: float) -> None:
     print(f"  MediaPipe face mesh, 640x480: {n / track_s:.0f} frames/s; brows from the image: "
           f"{n / brows_s:.0f} frames/s; landmarks to FAPs: {n / faps_s:.0f} frames/s; whole "
           f"path without decoding: {n / (track_s + brows_s + faps_s):.0f} frames/s")
+
+
+PROBE_FAPS = (3, 12, 13, 59, 60, 53, 54, 31, 32, 35, 36, 19, 20, 48, 49, 50)
+"""The FAP groups the probe's verdict covers (issue 37): jaw, lip corners, brows, lids,
+head."""
+
+
+def probe_report(title: str, face: Face | None) -> None:
+    """The probe stream (``closedloop.probe_stream``: FAP groups bumped one at a time, the
+    eyes ahead) with head turns and with the head still, pooled, and a still face turning
+    as the probe does for the wobble: per FAP the rule it is judged by, spread and wobble,
+    the correlation with its 95 % interval and effective samples, gain and error; the
+    largest false gaze outside blinks; the head's yaw gain."""
+    loops = [closed_loop(probe_stream(turns=turns), face=face) for turns in (True, False)]
+    still = closed_loop(still_face(probe_stream(turns=True)), face=face)
+    wobble = (still.tracked.stream.values.astype(np.float64)
+              - still.truth.values).std(axis=0)
+    found = agreement([loop.truth.values for loop in loops],
+                      [loop.tracked.stream.values for loop in loops], wobble, PROBE_FAPS)
+    print(f"\n{title}: probe stream with head turns and still, pooled "
+          f"({sum(loop.truth.n_frames for loop in loops)} frames)")
+    print(f"  {'FAP':>3}  {'name':<22} {'spread':>6} {'wobble':>6} {'judged':>11} {'r':>6} "
+          f"{'95 % interval':>14} {'samples':>7} {'gain':>5} {'error':>6}")
+    for a in found:
+        print(f"  {a.fap:>3}  {facelib.fap(a.fap).name:<22} {a.spread:6.0f} {a.wobble:6.0f} "
+              f"{a.judged:>11} {a.correlation:6.3f} {a.low:6.3f}-{a.high:6.3f} "
+              f"{a.samples:7.0f} {a.gain:5.2f} {a.error:6.0f}")
+    for loop, kind in zip(loops, ("turns", "still"), strict=True):
+        truth, values = loop.truth.values, loop.tracked.stream.values.astype(np.float64)
+        open_ = truth[:, 18] < 300
+        gaze = np.degrees(np.abs(values[open_][:, 22:26]) * ANGLE_UNIT).max(axis=0)
+        print(f"  head {kind}: largest false gaze outside blinks (23-26) "
+              + ", ".join(f"{g:.1f}" for g in gaze) + " degrees"
+              + (f"; head yaw gain {loop.gain(49):.3f}" if kind == "turns" else ""))
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process and its finished children (ffmpeg's decoding), seconds: on
+    a machine shared with other jobs the figure that does not move with their load."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def video_speed(path: Path, repeats: int = 2) -> None:
+    """The whole video-to-FAP path (``track_video_faps``: decoding, detection, the brows'
+    image registration, the model, smoothing) against MediaPipe's own landmark speed on
+    the same frames (decoded beforehand, not timed), side by side in CPU time, the best of
+    ``repeats`` runs each (issue 37's goal: a ratio of 0.8 or more)."""
+    from facelib.tracking.video import read_video, track_video_faps
+
+    frames = list(read_video(path)[1])
+    track_video_faps(path, max_frames=10)  # warm: imports, the model, MediaPipe's graph
+    mediapipe_s = whole_s = float("inf")
+    for _ in range(repeats):
+        with FaceMeshTracker(video=True, max_faces=1) as tracker:
+            started = cpu_seconds()
+            for image in frames:
+                tracker.detect(image)
+            mediapipe_s = min(mediapipe_s, cpu_seconds() - started)
+        started = cpu_seconds()
+        track_video_faps(path)
+        whole_s = min(whole_s, cpu_seconds() - started)
+    n = len(frames)
+    print(f"\nvideo to FAPs, {path.name} ({n} frames, {frames[0].shape[1]}x{frames[0].shape[0]}"
+          f"), CPU time: MediaPipe's landmarks alone {n / mediapipe_s:.0f} frames/s, the whole "
+          f"path (decode, detection, brows, model, smoothing) {n / whole_s:.0f} frames/s: "
+          f"ratio {mediapipe_s / whole_s:.2f}")
 
 
 def traced(call: Callable[[], object]) -> tuple[float, int]:
@@ -224,6 +300,14 @@ def main() -> None:
                       bilabial_spans(run.visemes), face)
         if title.startswith("hello.fdl with"):
             long_tracks(loop.landmarks, loop.truth.fps)
+            with tempfile.TemporaryDirectory() as folder:
+                video = Path(folder) / "hello.mp4"
+                facelib.render(with_neutral_lead(with_head_turns(run.faps), 8), out=video,
+                               progress=False)
+                video_speed(video)
+    for title, face in (("default head", None), ("cartoon head", cartoon),
+                        ("SOMA-X head", soma)):
+        probe_report(title, face)
 
 
 if __name__ == "__main__":

@@ -27,9 +27,10 @@ from facelib.tracking.mediapipe import N_LANDMARKS, FaceMeshTracker
 from facelib.tracking.observation import default_observation
 from facelib.tracking.pose import HEAD_FAP_IDS
 
-__all__ = ["LIPS_TOUCH", "ClosedLoop", "bilabial_closures", "closed_loop", "closure_events",
-           "closure_recall", "curve_correlation", "curve_gain", "event_recall",
-           "false_closures", "lip_closures", "lip_gap", "with_head_turns", "with_neutral_lead"]
+__all__ = ["LIPS_TOUCH", "PROBE_PLAN", "ClosedLoop", "bilabial_closures", "closed_loop",
+           "closure_events", "closure_recall", "curve_correlation", "curve_gain",
+           "event_recall", "false_closures", "lip_closures", "lip_gap", "probe_stream",
+           "still_face", "with_head_turns", "with_neutral_lead"]
 
 LIPS_TOUCH = 0.1
 """Inner-lip gap (:func:`lip_gap`, in MNS0) under which the lips count as touching."""
@@ -109,6 +110,54 @@ def with_head_turns(stream: FapStream, *, frames: int | None = None) -> FapStrea
         values[:, fap_id - 1] = ramp * sweep / ANGLE_UNIT
         mask[:, fap_id - 1] = True
     return FapStream(stream.fps, values, mask)
+
+
+PROBE_PLAN: tuple[tuple[tuple[int, float], ...], ...] = (
+    ((3, 400.0),), ((59, 250.0), (60, 250.0)), ((12, 400.0), (13, 400.0)),
+    ((31, 320.0), (32, 320.0), (33, 320.0), (34, 320.0), (35, 300.0), (36, 300.0)),
+    ((3, 300.0), (12, 300.0), (13, 300.0)), ((59, -200.0), (60, -200.0)),
+    ((19, 1000.0), (20, 1000.0)), ((3, 500.0),),
+    ((31, -120.0), (32, -120.0), (37, 100.0), (38, 100.0)), ((53, 150.0), (54, 150.0)))
+"""The probe stream's bumps, one after the other (FAP id, peak in FAP units), the eyes
+looking ahead throughout: the jaw alone (so a gaze it leaks into shows), the outer lip
+corners' raise apart from the inner ones and lowered, the brows raised to 300-320 (past
+facelib's library, as people raise them), the jaw with a smile, a blink, a frown, the outer
+corners' stretch. No storyboard moves FAPs one group at a time like this; the model never
+trained on it (issue 37's closed loop)."""
+
+
+def probe_stream(*, fps: float = 25.0, segment: int = 30, turns: bool = True,
+                 plan: tuple[tuple[tuple[int, float], ...], ...] = PROBE_PLAN) -> FapStream:
+    """Each bump of ``plan`` as a raised cosine over ``segment`` frames (2 frames of rest at
+    either end), one after the other; with ``turns``, head sweeps of yaw 25, pitch 8 and
+    roll 6 degrees (periods 4.5, 3.3 and 5.7 s, grown over the first second)."""
+    check_count("segment", segment, low=5)
+    n = segment * len(plan)
+    values = np.zeros((n, N_FAPS))
+    t = np.arange(n)
+    for k, bump in enumerate(plan):
+        a, b = k * segment + 2, (k + 1) * segment - 2
+        inside = (t >= a) & (t < b)
+        shape = np.where(inside, 0.5 - 0.5 * np.cos(2 * np.pi * (t - a) / (b - a)), 0.0)
+        for fap_id, peak in bump:
+            values[:, fap_id - 1] += peak * shape
+    if turns:
+        seconds = t / fps
+        ramp = np.clip(seconds, 0, 1)
+        for fap_id, degrees, period in ((48, 8, 3.3), (49, 25, 4.5), (50, 6, 5.7)):
+            values[:, fap_id - 1] = (ramp * np.radians(degrees)
+                                     * np.sin(2 * np.pi * seconds / period) / ANGLE_UNIT)
+    return FapStream(fps, values.astype(np.float32))
+
+
+def still_face(stream: FapStream) -> FapStream:
+    """``stream`` with every FAP but the head's (48-50) at 0: the still face whose
+    recovered curves measure the *wobble* head motion alone reads as expression
+    (:mod:`facelib.tracking.agreement`)."""
+    values = np.zeros_like(stream.values)
+    heads = [f - 1 for f in HEAD_FAP_IDS]
+    values[:, heads] = stream.values[:, heads]
+    return FapStream(stream.fps, values)
 
 
 def with_neutral_lead(stream: FapStream, frames: int) -> FapStream:

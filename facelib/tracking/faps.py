@@ -442,12 +442,34 @@ def measure_faps(
     return TrackedFaps(FapStream(rate, values, mask), rest.fapu, found.pose, filled)
 
 
+_GAZE = slice(22, 26)
+_UPPER_LIDS = slice(18, 20)
+
+
+def bridge_gaze(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """``(n, 84)`` ``values`` with the gaze (23-26) drawn straight across the frames whose
+    upper lids (19, 20) read closed (``model.json``, ``gaze_under_closed_lids``) from the
+    open frames either side (held at a track's ends); ``values`` itself where the mask has
+    no gaze and lids or no lid closes (a copy otherwise)."""
+    if not (mask[:, _GAZE].all() and mask[:, _UPPER_LIDS].all()):
+        return values
+    shut = values[:, _UPPER_LIDS].mean(axis=1) > _model()["gaze_under_closed_lids"]["lid_above"]
+    if not shut.any() or shut.all():
+        return values
+    out = np.array(values)
+    frames = np.arange(len(values))
+    for col in range(_GAZE.start, _GAZE.stop):
+        out[shut, col] = np.interp(frames[shut], frames[~shut], values[~shut, col])
+    return out
+
+
 def _over_time(found: MeasuredFrames, rate: float, closed: np.ndarray | None) -> np.ndarray:
     """The steps that need the whole recorded track, on ``found``'s ``(n, 84)`` values: the
-    One Euro filter both ways, then open_jaw drawn across the brief runs of ``closed``
+    gaze drawn across closed lids (:func:`bridge_gaze`), the One Euro filter both ways,
+    then open_jaw drawn across the brief runs of ``closed``
     ``(n,) bool`` frames (:func:`~facelib.tracking.lipclosure.bridge_jaw`; None: no mouth
     state)."""
-    values = _smooth(found.values, found.mask, rate)
+    values = _smooth(bridge_gaze(found.values, found.mask), found.mask, rate)
     if closed is not None:
         jaw = fap("open_jaw").index
         values[:, jaw] = lipclosure.bridge_jaw(

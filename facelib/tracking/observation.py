@@ -38,6 +38,7 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -195,7 +196,8 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                       faps: tuple[int, ...] = MODEL_FAPS,
                       components: int = 60, brows: np.ndarray | None = None,
                       image_faps: tuple[int, ...] = IMAGE_FAPS,
-                      regions: tuple[LandmarkRegion, ...] = ()) -> ObservationModel:
+                      regions: tuple[LandmarkRegion, ...] = (),
+                      segments: tuple[int, ...] = ()) -> ObservationModel:
     """Learn the model from ``(n, 478, 3)`` MediaPipe landmarks (image coordinates, no
     missing frames) of a face driven by ``(n, 84)`` known FAP ``values``.
 
@@ -206,7 +208,10 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     (some of ``faps``) are learned a second time, with them; ``regions``: FAPs learned from
     some landmarks alone (:class:`LandmarkRegion`; their estimator is 0 elsewhere), so that
     the motion of the rest of the face, which comes with them on the training head, is not
-    read as them on another face. ParameterError when ``values`` is not one row of 84 FAPs
+    read as them on another face; ``segments``: the frame counts of the training streams
+    laid end to end in ``landmarks`` (each with its own neutral frames ``neutral``, counted
+    from its own start, and its own FAPU: streams of several faces); empty, one stream.
+    ParameterError when ``values`` is not one row of 84 FAPs
     per landmark frame, ``brows`` not 4 finite numbers per frame, or a region's FAPs not
     among ``faps``.
     """
@@ -219,14 +224,25 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                               or not np.isfinite(brows).all()):
         raise ParameterError(f"brows must be ({len(known)}, 4) finite shifts, got "
                              f"{np.shape(brows)}")
-    moved, fapu, fitted = _normalised(landmarks, neutral)
+    lengths = tuple(segments) or (len(known),)
+    if sum(lengths) != len(known) or min(lengths) < 1:
+        raise ParameterError(f"segments {segments!r} must be frame counts adding up to "
+                             f"{len(known)}")
+    edges = np.concatenate([[0], np.cumsum(lengths)])
+    parts = [_normalised(np.asarray(landmarks)[a:b], neutral) for a, b in pairwise(edges)]
+    moved = np.concatenate([m for m, _, _ in parts])
+    fitted = np.concatenate([f for _, _, f in parts])
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
     if components > n - 2:
         raise ParameterError(f"{components} components need more than {components + 1} "
                              f"frames, got {n}")
     truth = known[:, ids - 1]
-    target = truth * fap_lengths(ids, fapu) / (fapu["ES"] * FAPU_SCALE)
+    scale = np.concatenate([np.broadcast_to(fap_lengths(ids, u) / (u["ES"] * FAPU_SCALE),
+                                            (b - a, len(ids)))
+                            for (_, u, _), (a, b) in zip(parts, pairwise(edges),
+                                                         strict=True)])
+    target = truth * scale
     pose_error = known[:, [f - 1 for f in HEAD_FAP_IDS]] * ANGLE_UNIT - fitted
     basis, scores = _principal(moved.reshape(n, -1), components)
     coef = _least_squares(scores, np.hstack([target, pose_error]))
@@ -241,7 +257,8 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
     chosen = _check_ids(image_faps, "image_faps")
     if not set(chosen.tolist()) <= set(ids.tolist()):
         raise ParameterError(f"image_faps {image_faps!r} must be among faps")
-    angles = fitted + pose_correction(model, moved * (fapu["ES"] * FAPU_SCALE), fapu)
+    unit = {"ES": 1.0 / FAPU_SCALE}  # the motion is over ES0 already
+    angles = fitted + pose_correction(model, moved, unit)
     columns = [int(np.flatnonzero(ids == f)[0]) for f in chosen]
     inputs = image_inputs(shifts, angles)
     coef = _least_squares(np.hstack([scores, inputs]), target[:, columns])

@@ -194,8 +194,109 @@ def extract_audio(video: str | os.PathLike[str], wav: str | os.PathLike[str]) ->
     return Path(wav)
 
 
+class _BrowPass:
+    """The brows' image shifts (:mod:`~facelib.tracking.browimage`) read in the tracking
+    pass itself, so the video is decoded once: against a provisional neutral (the frames
+    asked for, or the first with a face), the frames up to its end held until its
+    templates are made. :meth:`result` gives them when the track's final neutral is the
+    same frames, else None (then :func:`video_brows` reads the video again)."""
+
+    HOLD = 64
+    """Frames held at most while waiting for the neutral's end (64 MB at 640x480)."""
+    BATCH = 32
+    """Frames registered at a time after it (their poses are fitted together)."""
+
+    def __init__(self, neutral: int | tuple[int, int] | None, model: ObservationModel):
+        self.model = model
+        self.asked = neutral
+        self.span: slice | None = None
+        self.held: list[tuple[np.ndarray, np.ndarray]] = []
+        self.shifts: list[np.ndarray] = []
+        self.failed = False
+        self.patches: Any = None
+        self.rest: Any = None
+        self.frames = np.zeros(0, np.int64)
+        self.pending: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def _flush(self) -> None:
+        from facelib.tracking.browimage import brow_features
+
+        if self.pending:
+            self.shifts.extend(brow_features((image for image, _ in self.pending),
+                                             np.stack([p for _, p in self.pending]),
+                                             self.patches, self.rest, self.model))
+            self.pending = []
+
+    def add(self, image: np.ndarray, points: np.ndarray) -> None:
+        """Take the next frame and its ``(478, 3)`` landmarks (NaN: no face)."""
+        if self.failed:
+            return
+        if self.patches is not None:
+            self.pending.append((image, points))
+            if len(self.pending) == self.BATCH:
+                self._flush()
+            return
+        self.held.append((image, points))
+        if self.span is None:
+            if self.asked is None:
+                if np.isfinite(points).all():
+                    self.span = slice(len(self.held) - 1, len(self.held))
+            else:
+                start, stop = ((self.asked, self.asked + 1) if isinstance(self.asked, int)
+                               else self.asked)
+                self.span = slice(start, stop)
+        if (self.span is not None and self.span.stop > self.HOLD) or len(self.held) > self.HOLD:
+            self.failed, self.held = True, []
+        elif self.span is not None and len(self.held) == self.span.stop:
+            self._start()
+
+    def _start(self) -> None:
+        from facelib.tracking.browimage import brow_features, brow_patches
+        from facelib.tracking.headframe import neutral_face, neutral_frames
+        from facelib.tracking.layouts import landmark_layout
+
+        assert self.span is not None
+        points = np.stack([p for _, p in self.held])
+        lost = np.flatnonzero(~face_found(points)).tolist()
+        try:
+            frames = neutral_frames(self.span, lost)
+        except TrackingError:
+            self.failed, self.held = True, []
+            return
+        filled = points.copy()
+        filled[lost] = points[frames[0]]  # the neutral face reads the neutral frames alone
+        self.rest = neutral_face(filled, layout=landmark_layout("mediapipe"), span=self.span,
+                                 lost=lost)
+        self.frames = frames
+        self.patches = brow_patches((self.held[i][0] for i in frames), filled[frames],
+                                    self.rest, self.model)
+        self.shifts = list(brow_features((image for image, _ in self.held), points,
+                                         self.patches, self.rest, self.model))
+        self.held = []
+
+    def result(self, neutral: tuple[int, int], landmarks: np.ndarray) -> np.ndarray | None:
+        """``(n, 4)`` shifts when the final ``neutral`` span of the ``(n, 478, 3)`` final
+        ``landmarks`` (NaN: lost) is the provisional one's frames, else None."""
+        from facelib.tracking.headframe import neutral_frames
+
+        if not self.failed and self.patches is not None:
+            self._flush()
+        if self.failed or self.patches is None or len(self.shifts) != len(landmarks):
+            return None
+        lost = np.flatnonzero(~face_found(landmarks)).tolist()
+        try:
+            frames = neutral_frames(slice(*neutral), lost)
+        except TrackingError:
+            return None
+        if not np.array_equal(frames, self.frames):
+            return None
+        out = np.stack(self.shifts)
+        out[~face_found(landmarks)] = np.nan
+        return out
+
+
 def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
-                max_faces: int = 2) -> VideoTrack:
+                max_faces: int = 2, _brows: _BrowPass | None = None) -> VideoTrack:
     """Track a face through a video with MediaPipe's face mesh (the largest at first, then
     the one overlapping it most: :mod:`~facelib.tracking.mediapipe`).
 
@@ -214,6 +315,8 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
                 break
             found = tracker.detect(image)
             points.append(lost if found is None else found.points)
+            if _brows is not None:
+                _brows.add(image, points[-1])
             counts.append(0 if found is None else found.n_faces)
             light.append(float("nan") if found is None else _face_light(image, found.box))
     if not points:
@@ -283,15 +386,22 @@ def track_video_faps(path: str | os.PathLike[str], *, max_frames: int | None = N
     well-lit face, :meth:`VideoTrack.default_neutral`; ``fapu``, ``smooth``, ``states``) with
     the brows' image shifts (:func:`video_brows`) for the learned model (``rig``
     ``"auto"``, ``"observed"`` or an observation model) unless ``brows=None`` is given."""
-    track = track_video(path, max_frames=max_frames)
-    if options.get("neutral") is None:
+    rig = options.get("rig", "auto")
+    wanted = "brows" not in options and (rig in ("auto", "observed")
+                                         or isinstance(rig, ObservationModel))
+    model = rig if isinstance(rig, ObservationModel) else default_observation()
+    asked = options.get("neutral")
+    brow_pass = _BrowPass(asked, model) if wanted else None
+    track = track_video(path, max_frames=max_frames, _brows=brow_pass)
+    if asked is None:
         span = track.default_neutral().span
         options["neutral"] = (span.start, span.stop)
-    rig = options.get("rig", "auto")
-    if "brows" not in options and (rig in ("auto", "observed")
-                                   or isinstance(rig, ObservationModel)):
-        options["brows"] = video_brows(path, track.landmarks, neutral=options.get("neutral"),
-                                       model=rig if isinstance(rig, ObservationModel) else None)
+    if brow_pass is not None:
+        neutral = options["neutral"]
+        start, stop = (neutral, neutral + 1) if isinstance(neutral, int) else neutral
+        shifts = brow_pass.result((start, stop), track.landmarks)
+        options["brows"] = (shifts if shifts is not None else
+                            video_brows(path, track.landmarks, neutral=neutral, model=model))
     return track, measure_faps(track.landmarks, fps=track.info.fps, layout="mediapipe",
                                **options)
 
