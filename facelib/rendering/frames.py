@@ -131,9 +131,10 @@ def render(
                         framing=framing)
     if out is None and audio is not None and own.audio is None:
         raise ParameterError("audio is only used when writing an .mp4 (give out=...)")
+    mp4 = out is not None and Path(out).suffix.lower() == ".mp4"
     with tempfile.TemporaryDirectory(prefix="facelib-speech-") as folder:
         sound = clip.audio
-        if sound is None and out is not None and Path(out).suffix.lower() == ".mp4":
+        if sound is None and mp4:
             sound = speech_audio_file(clip, Path(folder) / "speech.wav")
         with FaceRenderer(face, width=width, height=height, background=background,
                           framing=framing) as renderer:
@@ -141,10 +142,9 @@ def render(
                                  camera=camera_of(clip, renderer, face, framing=framing))
             if out is None:
                 return _collect(frames, stream.n_frames, renderer.height, renderer.width)
-            mp4_audio = sound if Path(out).suffix.lower() == ".mp4" else None
-            return write_video(frames, out, fps=stream.fps, duration=stream.duration,
-                               width=width, height=height, audio=mp4_audio,
-                               audio_offset=clip.audio_offset)
+            return write_video(frames, out, fps=stream.fps, width=width, height=height,
+                               audio=sound if mp4 else None, audio_offset=clip.audio_offset,
+                               duration=stream.duration)
 
 
 def _collect(frames: Iterator[np.ndarray], n_frames: int, height: int, width: int
