@@ -123,8 +123,7 @@ def render(
     """
     own = make_clip(source, face=face)
     clip = make_clip(own, audio=audio, audio_offset=audio_offset)
-    if fps is not None:
-        clip = clip.resampled(fps)
+    clip = clip if fps is None else clip.resampled(fps)
     stream, face = clip.stream, clip.face_or_default()
     if out is not None and Path(out).suffix.lower() == ".png":
         return _one_png(face, stream, out, width=width, height=height, background=background,

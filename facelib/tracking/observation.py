@@ -224,24 +224,14 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                               or not np.isfinite(brows).all()):
         raise ParameterError(f"brows must be ({len(known)}, 4) finite shifts, got "
                              f"{np.shape(brows)}")
-    lengths = tuple(segments) or (len(known),)
-    if sum(lengths) != len(known) or min(lengths) < 1:
-        raise ParameterError(f"segments {segments!r} must be frame counts adding up to "
-                             f"{len(known)}")
-    edges = np.concatenate([[0], np.cumsum(lengths)])
-    parts = [_normalised(np.asarray(landmarks)[a:b], neutral) for a, b in pairwise(edges)]
-    moved = np.concatenate([m for m, _, _ in parts])
-    fitted = np.concatenate([f for _, _, f in parts])
+    moved, fitted, scale = _stacked(landmarks, len(known), ids, neutral=neutral,
+                                    segments=segments)
     n, n_land = moved.shape[:2]
     components = check_count("components", components, low=1)
     if components > n - 2:
         raise ParameterError(f"{components} components need more than {components + 1} "
                              f"frames, got {n}")
     truth = known[:, ids - 1]
-    scale = np.concatenate([np.broadcast_to(fap_lengths(ids, u) / (u["ES"] * FAPU_SCALE),
-                                            (b - a, len(ids)))
-                            for (_, u, _), (a, b) in zip(parts, pairwise(edges),
-                                                         strict=True)])
     target = truth * scale
     pose_error = known[:, [f - 1 for f in HEAD_FAP_IDS]] * ANGLE_UNIT - fitted
     basis, scores = _principal(moved.reshape(n, -1), components)
@@ -253,19 +243,48 @@ def learn_observation(landmarks: np.ndarray, values: np.ndarray, *,
                              _range(pose_error))
     if brows is None:
         return model
-    shifts = np.asarray(brows, np.float64)
     chosen = _check_ids(image_faps, "image_faps")
     if not set(chosen.tolist()) <= set(ids.tolist()):
         raise ParameterError(f"image_faps {image_faps!r} must be among faps")
+    return _with_image(model, np.asarray(brows, np.float64), chosen, moved=moved,
+                       fitted=fitted, basis=basis, scores=scores, target=target)
+
+
+def _with_image(model: ObservationModel, shifts: np.ndarray, chosen: np.ndarray, *,
+                moved: np.ndarray, fitted: np.ndarray, basis: np.ndarray,
+                scores: np.ndarray, target: np.ndarray) -> ObservationModel:
+    """``model`` with the FAPs ``chosen`` learned a second time from the landmark motion's
+    principal ``scores`` (on ``basis``) together with the ``(n, 4)`` brow image ``shifts``."""
     unit = {"ES": 1.0 / FAPU_SCALE}  # the motion is over ES0 already
     angles = fitted + pose_correction(model, moved, unit)
-    columns = [int(np.flatnonzero(ids == f)[0]) for f in chosen]
+    columns = [int(np.flatnonzero(model.faps == f)[0]) for f in chosen]
     inputs = image_inputs(shifts, angles)
     coef = _least_squares(np.hstack([scores, inputs]), target[:, columns])
+    components, n_land = scores.shape[1], moved.shape[1]
     return dataclasses.replace(
         model, image_faps=chosen,
         image_estimator=(basis.T @ coef[:components]).reshape(n_land, 2, len(chosen)),
         image_weights=coef[components:])
+
+
+def _stacked(landmarks: np.ndarray, n: int, ids: np.ndarray, *,
+             neutral: int | tuple[int, int], segments: tuple[int, ...]
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The training streams of ``segments`` (frame counts; empty: one stream of ``n``)
+    laid end to end, each normalised against its own neutral: the ``(n, L, 2)`` motion,
+    the ``(n, 3)`` fitted head angles and the ``(n, m)`` scale of each frame's FAPs ``ids``
+    from FAP units to its face's ES0 (each stream its own FAPU)."""
+    lengths = tuple(segments) or (n,)
+    if sum(lengths) != n or min(lengths) < 1:
+        raise ParameterError(f"segments {segments!r} must be frame counts adding up to {n}")
+    edges = np.concatenate([[0], np.cumsum(lengths)])
+    parts = [_normalised(np.asarray(landmarks)[a:b], neutral) for a, b in pairwise(edges)]
+    scale = np.concatenate([np.broadcast_to(fap_lengths(ids, u) / (u["ES"] * FAPU_SCALE),
+                                            (b - a, len(ids)))
+                            for (_, u, _), (a, b) in zip(parts, pairwise(edges),
+                                                         strict=True)])
+    return (np.concatenate([m for m, _, _ in parts]),
+            np.concatenate([f for _, _, f in parts]), scale)
 
 
 def _learn_region(estimator: np.ndarray, moved: np.ndarray, target: np.ndarray,
