@@ -99,3 +99,22 @@ def default_face():  # -> facelib.engine.Face
     from facelib.engine import load_face
 
     return load_face()
+
+
+@pytest.fixture
+def storyboard_source(tmp_path: Path) -> Callable[[str], object]:
+    """``make(body)``: an animation-like source (``faps``: one frame of zeros,
+    ``storyboard``: the file ``tmp_path/story.fdl`` holding ``body``, loaded)."""
+    from facelib.fdl import load
+
+    def make(body: str) -> object:
+        path = tmp_path / "story.fdl"
+        path.write_text(body)
+
+        class Source:
+            faps = FapStream(25, np.zeros((1, N_FAPS), np.float32))
+            storyboard = load(path)
+
+        return Source()
+
+    return make

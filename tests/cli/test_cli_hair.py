@@ -18,19 +18,6 @@ from facelib.export.source import export_clip
 from facelib.fdl import loads
 
 
-def _board(tmp_path: Path, body: str):
-    """An animation-like source of a storyboard file ``body`` (one frame of FAPs)."""
-    path = tmp_path / "story.fdl"
-    path.write_text(body)
-    from facelib.fdl import load
-
-    class Source:
-        faps = FapStream(25, np.zeros((1, 84), np.float32))
-        storyboard = load(path)
-
-    return Source()
-
-
 def test_the_bundled_head_lists_its_styles_and_bald(capsys):
     assert hair_style_names() == ("short", "long", "tied", "none")
     assert main(["list", "hair"]) == 0
@@ -39,22 +26,23 @@ def test_the_bundled_head_lists_its_styles_and_bald(capsys):
     assert all(len(line.split()) > 2 for line in lines)  # each with a description
 
 
-def test_the_storyboard_hair_global_dresses_its_face(tmp_path):
-    bald = make_clip(_board(tmp_path, 'hair = "none"\n')).face
+def test_the_storyboard_hair_global_dresses_its_face(tmp_path, storyboard_source):
+    bald = make_clip(storyboard_source('hair = "none"\n')).face
     assert "hair" not in bald.parts
-    tied = make_clip(_board(tmp_path, 'fps = 25\nhair = "tied"\n')).face
+    tied = make_clip(storyboard_source('fps = 25\nhair = "tied"\n')).face
     assert len(tied.parts["hair"].vertex_ids) == len(
         load_face(hair="tied").parts["hair"].vertex_ids)
     assert len(tied.parts["hair"].vertex_ids) != len(
         load_face(hair="short").parts["hair"].vertex_ids)
     # exports play on the bundled head but wear the storyboard's hair; a given face keeps its own
-    assert "hair" not in export_clip(_board(tmp_path, 'hair = "none"\n')).face.parts
+    assert "hair" not in export_clip(storyboard_source('hair = "none"\n')).face.parts
     short = load_face(hair="short")
-    assert make_clip(_board(tmp_path, 'hair = "none"\n'), face=short).face is short
+    assert make_clip(storyboard_source('hair = "none"\n'), face=short).face is short
 
 
-def test_an_unknown_storyboard_style_names_the_file_line_and_the_closest(tmp_path):
-    source = _board(tmp_path, 'fps = 25\n\nhair = "lnog"\n')
+def test_an_unknown_storyboard_style_names_the_file_line_and_the_closest(
+        tmp_path, storyboard_source):
+    source = storyboard_source('fps = 25\n\nhair = "lnog"\n')
     with pytest.raises(FdlError) as caught:
         make_clip(source)
     assert str(caught.value).startswith(f"{tmp_path / 'story.fdl'}:3: hair style 'lnog'")

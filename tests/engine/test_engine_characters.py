@@ -167,19 +167,8 @@ def test_an_unknown_character_gets_a_did_you_mean():
         face_definition("nobody")
 
 
-def _board(tmp_path: Path, body: str):
-    path = tmp_path / "story.fdl"
-    path.write_text(body)
-
-    class Source:
-        faps = FapStream(25, np.zeros((1, 84), np.float32))
-        storyboard = load(path)
-
-    return Source()
-
-
-def test_the_storyboard_face_names_a_character(tmp_path):
-    source = _board(tmp_path, 'fps = 25\nface = "mei"\nsay { text = "hi" }\n')
+def test_the_storyboard_face_names_a_character(tmp_path, storyboard_source):
+    source = storyboard_source('fps = 25\nface = "mei"\nsay { text = "hi" }\n')
     assert source.storyboard.face == "mei"
     assert storyboard_definition(source.storyboard) == face_definition("mei")
     face = make_clip(source).face
@@ -189,8 +178,8 @@ def test_the_storyboard_face_names_a_character(tmp_path):
     assert load(tmp_path / "story.fdl").face == (tmp_path / "mei").resolve()
 
 
-def test_a_misspelled_storyboard_character_names_its_line(tmp_path):
-    source = _board(tmp_path, 'fps = 25\n\nface = "omra"\n')
+def test_a_misspelled_storyboard_character_names_its_line(storyboard_source):
+    source = storyboard_source('fps = 25\n\nface = "omra"\n')
     with pytest.raises(FdlError, match=r"story\.fdl:3.*did you mean 'omar'\?"):
         make_clip(source)
 
