@@ -251,7 +251,15 @@ def main() -> None:
     from facelib.rendering.platform import import_pyrender
 
     import_pyrender(offscreen=True)  # chooses the headless platform before OpenGL loads
-    face = load_face(None)
+    # the head alone, as it is defined without its attachments (no bust, no hair): its AO
+    # serves every bust and hair style, and bald
+    doc = json.loads((HEAD / "default_head.json").read_text())
+    alone = HEAD / ".bake_head.json"  # beside the mesh files it names
+    alone.write_text(json.dumps({k: v for k, v in doc.items() if k not in ("bust", "hair")}))
+    try:
+        face = load_face(alone)
+    finally:
+        alone.unlink()
     ao = occlusion(face)
     write_occlusion(HEAD / "default_head.npz", ao)
     for name, part in face.parts.items():

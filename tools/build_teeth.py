@@ -106,18 +106,22 @@ class Kind:
     shape: str
 
 
-# typical adult crown sizes (mm; Wheeler's dental anatomy tables, rounded), midline outward
+# typical adult crown sizes (mm; Wheeler's dental anatomy tables, rounded), midline outward.
+# The slab's edge line rises 1.1 mm from the upper central incisors to the laterals and 3 mm
+# to the canines: the edges below bring the laterals' edges 0.8 mm and the canines' tips 1.9 mm
+# above the centrals' (a smile shows a row, not the centrals alone), and the lower laterals
+# and canines to the lower centrals' level (so they stay behind the longer uppers).
 TEETH = {
     "upper": (Kind("central incisor", 8.5, 7.0, 0.0, "incisor"),
-              Kind("lateral incisor", 6.5, 6.0, 0.9, "incisor"),
-              Kind("canine", 7.5, 8.0, 0.0, "canine"),
+              Kind("lateral incisor", 6.5, 6.0, -0.3, "incisor"),
+              Kind("canine", 7.5, 8.0, -1.0, "canine"),
               Kind("first premolar", 7.0, 9.0, 0.3, "premolar"),
               Kind("second premolar", 6.5, 9.0, 0.3, "premolar"),
               Kind("first molar", 10.0, 11.0, 0.2, "molar"),
               Kind("second molar", 9.0, 10.5, 0.3, "molar")),
     "lower": (Kind("central incisor", 5.0, 5.7, 0.0, "incisor"),
-              Kind("lateral incisor", 5.5, 6.1, 0.0, "incisor"),
-              Kind("canine", 7.0, 7.5, 0.8, "canine"),
+              Kind("lateral incisor", 5.5, 6.1, 0.5, "incisor"),
+              Kind("canine", 7.0, 7.5, 2.0, "canine"),
               Kind("first premolar", 7.0, 7.7, 0.3, "premolar"),
               Kind("second premolar", 7.0, 8.0, 0.3, "premolar"),
               Kind("first molar", 11.0, 10.5, 0.2, "molar"),
