@@ -8,9 +8,13 @@ pitches drawn per utterance; its PHONEME events give each phone's first sample, 
 the benchmarks score against). Texts: English from random words of the CMU dictionary that
 pocketsphinx ships; other languages from num2words (numbers, ordinals, years spelt out) and
 pseudo-words (a letter-bigram model of those words, and random syllables of the letters they
-use), read by espeak-ng's own rules for the language. Festival's voices (the benchmarks use
-them) and the held-out languages and voice variants (``HELD_OUT_*``, the benchmarks'
-language test) are never used.
+use), read by espeak-ng's own rules for the language. A share of the English utterances
+(``--flite-share``) is spoken by CMU Flite instead (Debian's ``flite``: its diphone voices
+``kal``, ``kal16`` and its statistical voices ``awb``, ``rms``, built from recordings of
+real speakers, so closer to natural speech than espeak-ng's formant synthesis), whose
+``-psdur`` output gives each phone's end time; flite's ``slt`` is never used (the benchmarks'
+Festival voice is that speaker). Festival's voices and the held-out languages and voice
+variants (``HELD_OUT_*``, the benchmarks' language test) are never used.
 
 Each utterance is then degraded at random (seeded): level (-35 to +3 dB, clipped), noise
 (white, pink, brown, babble of other utterances; 0-30 dB SNR), reverberation (decaying noise
@@ -59,6 +63,7 @@ from facelib.speech.acoustic import (  # noqa: E402
 from facelib.speech.audio import ALIGN_RATE, load_speech  # noqa: E402
 from facelib.speech.espeak import synth_fresh  # noqa: E402
 from facelib.speech.synth import events_to_timeline  # noqa: E402
+from facelib.speech.timeline import Span  # noqa: E402
 from facelib.visemes.mapping import visemes_for  # noqa: E402
 
 # espeak-ng voice -> num2words language (None: English, from the CMU dictionary)
@@ -71,6 +76,13 @@ TRAIN_VOICES = {
 }
 TRAIN_VARIANTS = ("", "+m1", "+m3", "+m4", "+m5", "+m6", "+f1", "+f3", "+f4", "+f5",
                   "+klatt", "+klatt2", "+klatt4", "+croak", "+Andy", "+belinda")
+FLITE_VOICES = ("kal", "kal16", "awb", "rms")
+"""CMU Flite's voices used (never ``slt``: the benchmarks' Festival voice is its speaker)."""
+FLITE_TO_ARPABET = {
+    "ax": "AH", "axr": "ER", "dx": "T", "el": "L", "em": "M", "en": "N", "hv": "HH",
+    "nx": "N", "pau": "SIL", "h#": "SIL", "brth": "SIL",
+}
+"""Flite's US phone set (Festival's "radio" set) -> ARPAbet (pocketsphinx en-us)."""
 HELD_OUT_VOICES = {"it": "it", "pt": "pt", "nl": "nl", "pl": "pl", "tr": "tr"}
 HELD_OUT_VARIANTS = ("", "+m2", "+f2", "+klatt3", "+m7")
 OFFSETS = (-20, -16, -12, -9, -7, -5, -4, -3, -2, -1, 0, 1, 2, 3, 4, 5, 6)
@@ -149,9 +161,10 @@ def make_text(words: list[str], english: bool, rng: np.random.Generator) -> str:
     return " ".join(out) + "."
 
 
-def requests(voices: dict[str, str | None], variants: tuple[str, ...], n: int, seed: int
-             ) -> list[tuple[str, str, int, int]]:
-    """``n`` seeded ``(text, voice, words_per_minute, pitch)`` synthesis requests."""
+def requests(voices: dict[str, str | None], variants: tuple[str, ...], n: int, seed: int,
+             *, flite_share: float = 0.0) -> list[tuple[str, str, int, int]]:
+    """``n`` seeded ``(text, voice, words_per_minute, pitch)`` synthesis requests; a share
+    ``flite_share`` of them English text for a Flite voice (``"flite:NAME"``)."""
     rng = np.random.default_rng([seed, 1])
     vocab = {v: vocabulary(lang, np.random.default_rng([seed, 2, i]))
              for i, (v, lang) in enumerate(sorted(voices.items()))}
@@ -161,29 +174,74 @@ def requests(voices: dict[str, str | None], variants: tuple[str, ...], n: int, s
         voice = names[rng.integers(len(names))]
         variant = variants[rng.integers(len(variants))]
         text = make_text(vocab[voice], voices[voice] is None, rng)
-        out.append((text, voice + variant, int(rng.integers(120, 271)),
-                    int(rng.integers(20, 81))))
+        spoken_by = voice + variant
+        if flite_share and rng.random() < flite_share:
+            text = make_text(vocab["en-us"], english=True, rng=rng)
+            spoken_by = "flite:" + FLITE_VOICES[rng.integers(len(FLITE_VOICES))]
+        out.append((text, spoken_by, int(rng.integers(120, 271)), int(rng.integers(20, 81))))
     return out
+
+
+def flite_speak(text: str, voice: str, words_per_minute: int, pitch: int
+                ) -> tuple[np.ndarray, list[Span]]:
+    """``text`` spoken by Flite's ``voice``: ``(16 kHz samples, ARPAbet phones)``, the
+    rate (``duration_stretch``) and mean pitch (``int_f0_target_mean``, 20-80 -> 85-205 Hz)
+    as asked. FacelibError when flite is missing or fails."""
+    import shutil
+    import subprocess
+    import tempfile
+
+    import soundfile
+
+    if shutil.which("flite") is None:
+        raise FacelibError("flite is missing (apt-get install flite), or use --flite-share 0")
+    with tempfile.TemporaryDirectory() as tmp:
+        wav = Path(tmp, "out.wav")
+        done = subprocess.run(
+            ["flite", "-voice", voice, "--setf", f"duration_stretch={175 / words_per_minute:.3f}",
+             "--setf", f"int_f0_target_mean={85 + 2 * pitch}", "-psdur", "-t", text,
+             "-o", str(wav)], capture_output=True, text=True, check=False)
+        if done.returncode != 0 or not wav.exists():
+            raise FacelibError(f"flite failed on {text!r}: {done.stderr.strip()[-200:]}")
+        samples, rate = soundfile.read(str(wav), dtype="float32")
+    phones: list[Span] = []
+    start = 0
+    for item in done.stdout.split():
+        label, _, end_s = item.rpartition(":")
+        end = round(float(end_s) * 1000)
+        label = FLITE_TO_ARPABET.get(label, label.upper())
+        if phones and label == "SIL" and phones[-1].label == "SIL":
+            phones[-1] = Span("SIL", phones[-1].start_ms, end)
+        elif end > start:
+            phones.append(Span(label, start, end))
+        start = max(start, end)
+    return load_speech(samples, sample_rate=rate), phones
 
 
 def synthesize(batch: list[tuple[str, str, int, int]], rng: np.random.Generator
                ) -> list[tuple[np.ndarray, np.ndarray] | None]:
     """Each request's ``(samples at 16 kHz, frame viseme ids)`` with 50-600 ms of silence
     added before and after (espeak-ng leaves almost none); None where it failed."""
+    espoken = [r for r in batch if not r[1].startswith("flite:")]
     try:
-        raws = synth_fresh(batch)
+        raws = iter(synth_fresh(espoken) if espoken else [])
     except FacelibError:
         if len(batch) == 1:
             return [None]
         return [r for b in batch for r in synthesize([b], rng)]
     out: list[tuple[np.ndarray, np.ndarray] | None] = []
-    for (text, _, _, _), raw in zip(batch, raws, strict=True):
+    for text, voice, wpm, pitch in batch:
         try:
-            timeline = events_to_timeline(raw.events, text, n_samples=raw.samples.size,
-                                          sample_rate=raw.sample_rate)
-            visemes = visemes_for(timeline.phones, alphabet="ipa")
-            samples = load_speech(raw.samples.astype(np.float32) / 32768,
-                                  sample_rate=raw.sample_rate)
+            if voice.startswith("flite:"):
+                samples, phones = flite_speak(text, voice.removeprefix("flite:"), wpm, pitch)
+                visemes = visemes_for(phones, alphabet="arpabet")
+            else:
+                raw = next(raws)
+                timeline = events_to_timeline(raw.events, text, n_samples=raw.samples.size,
+                                              sample_rate=raw.sample_rate)
+                visemes = visemes_for(timeline.phones, alphabet="ipa")
+                samples = load_speech(raw.samples.astype(np.float32) / 32768,
+                                      sample_rate=raw.sample_rate)
         except FacelibError:
             out.append(None)
             continue
@@ -384,7 +442,10 @@ def save(net: object, args: argparse.Namespace, *, mean: np.ndarray, scale: np.n
         "n_mels": N_MELS, "n_fft": N_FFT, "lag": LAG, "feature_warp": bool(args.feature_warp),
         "level_normalisation": init is not None,
         "validation_frame_accuracy": round(accuracy, 4), "seconds": round(seconds),
-        "synthesis": "libespeak-ng (espeakng-loader wheel); no Festival voice",
+        "synthesis": "libespeak-ng (espeakng-loader wheel) and, for a share "
+                     f"{args.flite_share:g} of the utterances, CMU Flite's voices "
+                     f"{', '.join(FLITE_VOICES)}; no Festival voice, no slt",
+        "flite_share": args.flite_share,
     }
     arrays["info"] = np.array(json.dumps(info))
     args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -414,6 +475,8 @@ def main() -> None:
     parser.add_argument("--work", type=Path, default=Path("/tmp/facelib-viseme-train"))
     parser.add_argument("--out", type=Path,
                         default=ROOT / "facelib" / "data" / "visemes" / "acoustic_model.npz")
+    parser.add_argument("--flite-share", type=float, default=0.35,
+                        help="share of utterances spoken by CMU Flite's voices (English)")
     parser.add_argument("--penalty", type=float, default=4.0)
     parser.add_argument("--cmn", type=int, default=0,
                         help="1: causal level and channel normalisation of the features")
@@ -425,12 +488,15 @@ def main() -> None:
 
     t0 = time.time()
     args.work.mkdir(parents=True, exist_ok=True)
-    reqs = requests(TRAIN_VOICES, TRAIN_VARIANTS, args.utterances, args.seed)
-    x, y, starts = dataset(reqs, args.work, f"train{args.seed}-{args.utterances}", args.seed,
-                           augment=True)
+    reqs = requests(TRAIN_VOICES, TRAIN_VARIANTS, args.utterances, args.seed,
+                    flite_share=args.flite_share)
+    x, y, starts = dataset(reqs, args.work,
+                           f"train{args.seed}-{args.utterances}-f{args.flite_share:g}",
+                           args.seed, augment=True)
     val_reqs = requests(TRAIN_VOICES, TRAIN_VARIANTS, max(args.utterances // 20, 40),
-                        args.seed + 1)
-    xv, yv, sv = dataset(val_reqs, args.work, f"val{args.seed}-{args.utterances}",
+                        args.seed + 1, flite_share=args.flite_share)
+    xv, yv, sv = dataset(val_reqs, args.work,
+                         f"val{args.seed}-{args.utterances}-f{args.flite_share:g}",
                          args.seed + 1, augment=True)
     print(f"data: {x.shape[0] / 100 / 3600:.2f} h train, {xv.shape[0] / 100 / 60:.1f} min "
           f"validation, {time.time() - t0:.0f} s", flush=True)
