@@ -12,8 +12,10 @@ from __future__ import annotations
 import logging
 import os
 import subprocess
+import tempfile
 import warnings
 from collections.abc import Iterator
+from contextlib import suppress
 from dataclasses import dataclass
 from itertools import islice
 from pathlib import Path
@@ -132,26 +134,22 @@ def _not_turned(record: logging.LogRecord) -> bool:
     return "different from the source frame size" not in record.getMessage()
 
 
-def _start(path: Path, rate: float | None = None) -> tuple[Any, dict[str, Any]]:
-    """ffmpeg decoding ``path`` to RGB, at ``rate`` frames a second, and the metadata it
-    reports; rate None: a probe (the first frame alone, on one thread: a third of the time
-    of a whole decode's start); TrackingError when it finds no video stream."""
-    if rate is None:
-        inputs, options = ["-threads", "1"], ["-frames:v", "1"]
-    else:
-        inputs, options = None, ["-vf", f"fps={rate!r}"]
-    reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24", input_params=inputs,
-                                           output_params=options)
+def _probe(path: Path) -> dict[str, Any]:
+    """The metadata ffmpeg reports on ``path`` (decoding its first frame alone, on one
+    thread); TrackingError when it finds no video stream."""
+    reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24",
+                                           input_params=["-threads", "1"],
+                                           output_params=["-frames:v", "1"])
     ffmpeg_log = logging.getLogger("imageio_ffmpeg")
     ffmpeg_log.addFilter(_not_turned)
     try:
-        return reader, next(reader)
+        return dict(next(reader))
     except (OSError, RuntimeError, StopIteration) as exc:
-        reader.close()
         first = (str(exc).strip().splitlines() or ["no message"])[0]
         raise TrackingError(f"ffmpeg cannot read a video stream from it ({first})",
                             path=path) from exc
     finally:
+        reader.close()
         ffmpeg_log.removeFilter(_not_turned)
 
 
@@ -167,8 +165,7 @@ def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.nda
     path = Path(path)
     if not path.is_file():
         raise TrackingError(f"video {str(path)!r} does not exist")
-    probe, meta = _start(path)
-    probe.close()
+    meta = _probe(path)
     average = float(meta.get("fps") or 0)
     if not average > 0:
         raise TrackingError("the video has no frame rate", path=path)
@@ -179,18 +176,47 @@ def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.nda
     if tuple(meta.get("source_size", meta["size"])) != tuple(meta["size"]):
         log.info("%s: stored %s, read %s: ffmpeg turns the frames as the file says", path,
                  "x".join(map(str, meta["source_size"])), "x".join(map(str, meta["size"])))
-    reader = _start(path, fps)[0]
     width, height = (int(v) for v in meta["size"])
     info = VideoInfo(fps, width, height, bool(meta.get("audio_codec")))
+    return info, _decode(path, fps, width, height)
 
-    def frames() -> Iterator[np.ndarray]:
+
+def _decode(path: Path, fps: float, width: int, height: int) -> Iterator[np.ndarray]:
+    """``(height, width, 3) uint8`` RGB frames of ``path`` at ``fps`` from one ffmpeg, read
+    from a pipe that holds a whole frame (Linux: the default 64 KiB one costs a fifth of
+    ffmpeg's own decoding time in switches between it and this process)."""
+    size = width * height * 3
+    command = [_imageio_ffmpeg().get_ffmpeg_exe(), "-nostdin", "-hide_banner", "-loglevel",
+               "error", "-i", str(path), "-vf", f"fps={fps!r}", "-f", "rawvideo", "-pix_fmt",
+               "rgb24", "-"]
+    with tempfile.TemporaryFile() as errors, subprocess.Popen(
+            command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=errors) as ffmpeg:
+        assert ffmpeg.stdout is not None
+        _widen(ffmpeg.stdout.fileno(), size)
         try:
-            for raw in reader:
+            while raw := ffmpeg.stdout.read(size):
+                if len(raw) < size:
+                    errors.seek(0)
+                    said = errors.read().decode(errors="replace").strip().splitlines()
+                    raise TrackingError(f"ffmpeg stopped within a frame ({(said or [''])[-1]})",
+                                        path=path)
                 yield np.frombuffer(raw, np.uint8).reshape(height, width, 3)
         finally:
-            reader.close()
+            if ffmpeg.poll() is None:
+                ffmpeg.kill()
 
-    return info, frames()
+
+_PIPE_MAX = 1 << 20
+"""The largest pipe Linux lets a process ask for by default (``/proc/sys/fs/pipe-max-size``)."""
+
+
+def _widen(pipe: int, size: int) -> None:
+    """Ask for the pipe ``pipe`` (a file descriptor) to hold ``size`` bytes, at most
+    :data:`_PIPE_MAX`; where that cannot be asked (not Linux) or is refused, it stays."""
+    with suppress(ImportError, AttributeError, OSError):
+        import fcntl
+
+        fcntl.fcntl(pipe, fcntl.F_SETPIPE_SZ, min(size, _PIPE_MAX))
 
 
 def extract_audio(video: str | os.PathLike[str], wav: str | os.PathLike[str]) -> Path:
