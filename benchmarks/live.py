@@ -5,7 +5,11 @@
 - audio in (100 ms chunks, real time) -> the frame that carries that audio (p50/p95);
 - K concurrent wall-clock sessions at 30 frames/s, all starting at once and each saying
   two sentences: frames out per second, the lag of frames behind their due time (p50/p95,
-  the worst, and the worst once the start is over).
+  the worst, and the worst once the start is over);
+- memory of one session over a long input on the manual clock (as fast as it computes):
+  an hour of text (a sentence every 4 s) and ten minutes of streamed audio, the memory
+  the session holds (``tracemalloc``) and the process's peak resident size every few
+  minutes of session time (bounded: flat after the first epoch).
 
 Run: ``PYTHONPATH=. python benchmarks/live.py [--sentences 20] [--sessions 10]``.
 """
@@ -14,7 +18,9 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import resource
 import time
+import tracemalloc
 
 import numpy as np
 
@@ -113,6 +119,45 @@ async def concurrent(k: int, seconds: float) -> tuple[float, np.ndarray, np.ndar
     return float(np.mean(counts)) / seconds, lag, at
 
 
+async def memory(minutes: int, *, audio: bool) -> list[tuple[int, float, float, float]]:
+    """``(minute, MB held, peak resident MB, compute s since the last row)`` of one
+    manual-clock session fed ``minutes`` of input: a sentence every 4 s, or (``audio``)
+    synthesized speech in 100 ms chunks."""
+    every_s, report = 4.0, max(1, minutes // 6)
+    rows = []
+    async with Session(fps=30, clock="manual", seed=1, audio_in=audio) as s:
+        pcm = None
+        if audio:
+            from facelib.speech import synthesize
+            from facelib.speech.audio import load_speech
+
+            made = synthesize(" ".join(SENTENCES))
+            pcm = load_speech(made.samples, sample_rate=made.sample_rate)
+        await s.advance(1000)
+        tracemalloc.start()
+        base = tracemalloc.get_traced_memory()[0]
+        k, tick = 0, time.perf_counter()
+        for minute in range(1, minutes + 1):
+            while (k + 1) * (0.1 if audio else every_s) <= minute * 60:
+                if pcm is None:
+                    await s.say(SENTENCES[k % len(SENTENCES)])
+                    k += 1
+                    await s.advance(k * every_s * 1000)
+                else:
+                    first = (k * 1600) % (pcm.size - 1600)
+                    await s.audio(pcm[first:first + 1600])
+                    k += 1
+                    await s.advance(k * 100)
+            await s.advance(minute * 60_000)
+            if minute % report == 0:
+                held = (tracemalloc.get_traced_memory()[0] - base) / 1e6
+                rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3
+                rows.append((minute, held, rss, time.perf_counter() - tick))
+                tick = time.perf_counter()
+        tracemalloc.stop()
+    return rows
+
+
 def _pct(values: list[float]) -> str:
     ms = np.array(values) * 1000
     return f"p50 {np.percentile(ms, 50):.0f} ms, p95 {np.percentile(ms, 95):.0f} ms (n={ms.size})"
@@ -124,10 +169,12 @@ def main() -> None:
     parser.add_argument("--audio-s", type=float, default=8.0)
     parser.add_argument("--sessions", type=int, default=10)
     parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--only", choices=("text", "audio", "load"), action="append",
+    parser.add_argument("--memory-minutes", type=int, default=60,
+                        help="minutes of text for the memory part (audio: a sixth)")
+    parser.add_argument("--only", choices=("text", "audio", "load", "memory"), action="append",
                         help="run only these parts (repeatable; default all)")
     args = parser.parse_args()
-    parts = set(args.only or ("text", "audio", "load"))
+    parts = set(args.only or ("text", "audio", "load", "memory"))
     if "text" in parts:
         mouth, voiced, cold = asyncio.run(text_latency(args.sentences))
         print(f"text in -> first mouth frame, the process's first sentence: {cold * 1000:.0f} ms")
@@ -141,6 +188,13 @@ def main() -> None:
         print(f"{args.sessions} sessions at 30 fps: {fps:.1f} frames/s each; frame lag "
               f"{_pct(list(lag))}, worst {lag.max() * 1000:.0f} ms; after the first 2 s "
               f"worst {lag[at >= 2].max() * 1000:.0f} ms")
+    if "memory" in parts:
+        for audio, minutes in ((False, args.memory_minutes),
+                               (True, max(1, args.memory_minutes // 6))):
+            rows = asyncio.run(memory(minutes, audio=audio))
+            print(f"one session, {minutes} min of {'audio' if audio else 'text'}: " + "; ".join(
+                f"{m} min {held:.0f} MB held, peak RSS {rss:.0f} MB ({s:.0f} s)"
+                for m, held, rss, s in rows))
 
 
 if __name__ == "__main__":

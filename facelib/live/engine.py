@@ -8,10 +8,12 @@ yet handed out (``lead_ms`` later for speech, whose envelope ramps in before it 
 every generator is causal, so the frames already handed out are those a recomputation with
 the new input would give: the session's frames are the offline pipeline's.
 
-An epoch ends when the session is quiet (nothing said or shown) and it has lasted
-``epoch_s``: the next one starts at the next frame with a seed of its own, and the face
-cross-fades from the old epoch's eyes and head to the new one's over ``crossfade_ms``, so
-the window (time and memory per frame) stays bounded however long the session runs. Time
+An epoch ends when it has lasted ``epoch_s`` and nothing placed in it goes on past the
+next frame (quiet, or between two utterances: streamed audio never stops, but its
+stretches do): the next one starts at that frame with a seed of its own and takes over the
+input placed from there on, and the face cross-fades from the old epoch's eyes and head to
+the new one's over ``crossfade_ms``, so the window (time and memory per frame) stays
+bounded however long the session runs. Time
 here is the engine's own (frames at ``fps`` from 0); :class:`facelib.live.session.Session`
 ties it to the wall clock.
 """
@@ -63,6 +65,7 @@ class _Epoch:
     start: int  # first frame (session frames)
     plan: Plan
     window: Window | None = None
+    heard_until_ms: float = math.inf  # its utterances from here on play in the next epoch
 
 
 class Engine:
@@ -141,7 +144,7 @@ class Engine:
         spec = SpeechSpec(text=text, start_ms=self._local(start), style=style)
         animation = animate_spoken(spec, timeline, audio, fps=self.fps)
         utterances.append(Utterance(self._local(start), timeline, animation, audio, text,
-                                    playback or audio))
+                                    playback or audio, style))
         self._set(replace(plan, utterances=tuple(utterances)))
         return start
 
@@ -224,17 +227,45 @@ class Engine:
                      np.array(mask, bool), viseme, speaking)
 
     def _maybe_new_epoch(self) -> None:
-        """Start the next epoch at the next frame when this one is long and quiet."""
+        """Start the next epoch at the next frame when this one is long and nothing in it
+        goes on past that frame."""
         e = self._epoch
         local = self.committed - e.start
         if local < self.epoch_frames or self._previous is not None:
             return
-        if local < e.plan.content_frames:
-            return
-        self._previous = e
         seed = (self.seed * 1_000_003 + self._epochs) % 2**63
+        shift = round(self.frame_ms(self.committed)) - round(self.frame_ms(e.start))
+        plan = (Plan(self.fps, seed) if local >= e.plan.content_frames
+                else self._carried(e.plan, shift, seed))
+        if plan is None:
+            return
+        e.heard_until_ms = shift
+        self._previous = e
         self._epochs += 1
-        self._epoch = _Epoch(self.committed, Plan(self.fps, seed))
+        self._epoch = _Epoch(self.committed, plan)
+
+    def _carried(self, plan: Plan, shift: int, seed: int) -> Plan | None:
+        """The next epoch's plan, starting ``shift`` ms into ``plan``'s epoch: the cues and
+        utterances that start there or later, their times from there; None when something
+        placed earlier goes on for more than a frame past it (what ends within the frame,
+        and an utterance's release ramp, the old epoch plays through the cross-fade)."""
+        ends = shift + 1000.0 / self.fps
+        spans = [(c.start_ms, c.end_ms) for c in (*plan.expressions, *plan.gaze, *plan.camera)]
+        spans += [(u.start_ms, u.end_ms) for u in plan.utterances]
+        if any(start < shift and end > ends for start, end in spans):
+            return None
+
+        def later(items: tuple) -> tuple:
+            return tuple(replace(c, start_ms=c.start_ms - shift) for c in items
+                         if c.start_ms >= shift)
+
+        utterances = tuple(
+            replace(u, start_ms=u.start_ms - shift, animation=animate_spoken(
+                SpeechSpec(text=u.text, start_ms=u.start_ms - shift, style=u.style),
+                u.timeline, u.audio, fps=self.fps))
+            for u in plan.utterances if u.start_ms >= shift)
+        return Plan(self.fps, seed, later(plan.expressions), later(plan.gaze),
+                    later(plan.camera), utterances)
 
     def audio(self, first_ms: float, last_ms: float, *, sample_rate: int) -> np.ndarray:
         """``(n,) float32`` speech placed in ``[first_ms, last_ms)`` (session ms) at
@@ -251,7 +282,8 @@ class Engine:
             base = round(self.frame_ms(epoch.start) * sample_rate / 1000)
             for u in epoch.plan.utterances:
                 sound = u.playback
-                if sound is None or sound.sample_rate != sample_rate:
+                if (sound is None or sound.sample_rate != sample_rate
+                        or u.start_ms >= epoch.heard_until_ms):
                     continue
                 at = base + round(u.start_ms * sample_rate / 1000) - first
                 lo, hi = max(at, 0), min(at + sound.samples.size, n)

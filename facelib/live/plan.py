@@ -36,6 +36,7 @@ class Utterance:
         None.
     text: what is said, or None for received audio.
     playback: the samples the session plays (``audio`` at the output rate), or None.
+    style: the speaking style it was animated with.
     """
 
     start_ms: int
@@ -44,6 +45,7 @@ class Utterance:
     audio: SpeechAudio | None
     text: str | None = None
     playback: SpeechAudio | None = None
+    style: str | float = "normal"
 
     @property
     def end_ms(self) -> int:

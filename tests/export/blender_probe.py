@@ -4,7 +4,9 @@ what Blender made of it as JSON.
 
 FRAMES: comma-separated animation frames (0-based); JOINTS: comma-separated joint-name
 prefixes (``lid_upper_l`` turns every bone ``lid_upper_l_*``). The JSON holds the mesh objects'
-names and vertex counts, for each mesh object with shape keys each frame's shape-key values
+names and vertex counts, for each mesh object with a UV layer its layers' names and each
+vertex's UV (the first loop's, and the largest gap to its other loops' UVs), for each mesh
+object with shape keys each frame's shape-key values
 by name, and for each prefix and mesh object the glTF-space (y up) rest positions of the
 object's vertices that move when those bones turn.
 """
@@ -45,6 +47,21 @@ def _world_positions(obj: "bpy.types.Object") -> list["mathutils.Vector"]:
     return out
 
 
+def _vertex_uvs(obj: "bpy.types.Object") -> dict:
+    """The object's UV layers, each vertex's UV on the first layer (its first loop's) and the
+    largest distance between the UVs of one vertex's loops."""
+    mesh = obj.data
+    layer = mesh.uv_layers[0].data
+    first: dict[int, list[float]] = {}
+    gap = 0.0
+    for loop in mesh.loops:
+        uv = list(layer[loop.index].uv)
+        seen = first.setdefault(loop.vertex_index, uv)
+        gap = max(gap, abs(seen[0] - uv[0]), abs(seen[1] - uv[1]))
+    return {"layers": [u.name for u in mesh.uv_layers],
+            "uv": [first.get(v, [-1.0, -1.0]) for v in range(len(mesh.vertices))], "gap": gap}
+
+
 def main() -> None:
     path, out, fps, frames, prefixes = _args()
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -56,7 +73,8 @@ def main() -> None:
     armature = next(o for o in scene.objects if o.type == "ARMATURE")
     report: dict = {"meshes": {o.name: len(o.data.vertices) for o in meshes},
                     "bones": [b.name for b in armature.pose.bones],
-                    "frame_start": scene.frame_start, "shape_keys": {}, "follow": {}}
+                    "frame_start": scene.frame_start, "shape_keys": {}, "follow": {},
+                    "uv": {o.name: _vertex_uvs(o) for o in meshes if o.data.uv_layers}}
     for obj in keyed:
         blocks = obj.data.shape_keys.key_blocks
         report["shape_keys"][obj.name] = {

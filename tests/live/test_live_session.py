@@ -125,6 +125,31 @@ def test_streamed_audio_moves_the_jaw_in_its_frames() -> None:
     assert jaw.max() > 0 and any(o.frame.viseme > 0 for o in frames)
 
 
+def test_streamed_audio_that_never_stops_still_ends_epochs() -> None:
+    """A microphone streams without a break: an epoch ends between two stretches of its
+    audio, the next takes the stretch that starts there, and each sample is heard once."""
+    from facelib.speech import synthesize
+    from facelib.speech.audio import load_speech
+
+    made = synthesize("Say it again, and again, please.")
+    said = load_speech(made.samples, sample_rate=made.sample_rate)
+    pcm = np.tile(np.concatenate([said, np.zeros(8000, np.float32)]), 6)  # about 16 s
+    with SyncSession(clock="manual", lookahead_ms=80, epoch_s=2.0, queue_s=30) as s:
+        for k in range(0, pcm.size - 1600, 1600):
+            s.audio((pcm[k:k + 1600] * 32767).astype("<i2").tobytes())
+            s.advance((k // 1600 + 1) * 100)
+        s.stop()
+        frames = list(s.frames())
+        # the first stretch (about 10.5 s) ends an epoch, the stop another: with epochs
+        # waiting for a quiet session, only the stop would
+        assert s.session.engine._epochs == 3
+    heard = np.concatenate([o.audio for o in frames])
+    sent = np.abs(pcm).max()
+    assert 0.8 * sent < np.abs(heard).max() < 1.2 * sent  # none of it twice over
+    jaw = np.array([o.frame.faps[2] for o in frames])  # FAP 3, open_jaw
+    assert jaw[330:450].max() > 0.5 * jaw.max()  # the carried stretch moves the mouth
+
+
 def test_windows_computed_ahead_on_the_wall_clock_give_the_same_frames() -> None:
     async def run() -> list:
         async with Session(fps=30, seed=4) as s:  # wall clock: windows come from a thread
