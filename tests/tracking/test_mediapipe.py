@@ -63,6 +63,34 @@ def test_a_video_follows_its_face_when_a_larger_one_comes(default_head_render):
     assert all(f.box[0] > 640 for f in found)  # the small face, on the right half
 
 
+def test_faces_counted_on_some_frames_name_them_all(default_head_render):
+    """A video's track looks for one face and counts faces on some frames: a second face
+    coming after the first is counted on every frame it is in (back from the count that
+    finds it), and the first is kept; two faces where the face is first found: the track
+    looks for two from there, keeping the largest, as before."""
+    from PIL import Image
+
+    from facelib.tracking.video import _COUNT_EVERY, _Faces
+
+    image, _ = default_head_render
+    small = np.asarray(Image.fromarray(image).resize((480, 360)))
+    alone = np.zeros((480, 1280, 3), np.uint8)
+    alone[60:420, 720:1200] = small
+    joined = alone.copy()
+    joined[:, :640] = image
+    for frames, counts, right in (([alone] * (_COUNT_EVERY + 2) + [joined] * 3,
+                                   [1] * (_COUNT_EVERY + 2) + [2] * 3, True),
+                                  ([joined] * 3, [2] * 3, False)):
+        faces = _Faces(2)
+        try:
+            found = [faces.detect(frame) for frame in frames]
+            faces.finish()
+        finally:
+            faces.close()
+        assert faces.counts == counts
+        assert all(f is not None and (f.box[0] > 640) == right for f in found)
+
+
 def test_the_face_kept_is_the_one_overlapping_most():
     """Overlap as intersection over union: the same face moved a little wins over a larger
     box around it; with nothing kept before, or no overlap, the largest."""

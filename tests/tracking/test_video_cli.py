@@ -107,7 +107,7 @@ def test_lost_stretch_and_a_second_face_are_named(face_video, tmp_path, capsys):
         frame = np.array(image)
         if 5 <= i <= 7:
             frame[:] = 40                                   # the face is gone
-        elif 10 <= i <= 12:                                 # a smaller second face
+        elif i >= 10:               # a smaller second face (faces are counted on some frames)
             small = np.asarray(Image.fromarray(image[60:420, 160:480]).resize((200, 225)))
             frame[250:475, 435:635] = small
         writer.write(frame)
@@ -116,7 +116,7 @@ def test_lost_stretch_and_a_second_face_are_named(face_video, tmp_path, capsys):
     err = capsys.readouterr().err
     assert status == 0, err
     assert "no face in frames 5-7 of 16; interpolated" in err
-    assert "several faces in frames 10-12; followed the one tracked before" in err
+    assert "several faces in frames 10-15; followed the one tracked before" in err
     assert read_fap(tmp_path / "e.fap").n_frames == N
 
 
