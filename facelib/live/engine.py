@@ -250,7 +250,9 @@ class Engine:
         placed earlier goes on for more than a frame past it (what ends within the frame,
         and an utterance's release ramp, the old epoch plays through the cross-fade)."""
         ends = shift + 1000.0 / self.fps
-        spans = [(c.start_ms, c.end_ms) for c in (*plan.expressions, *plan.gaze, *plan.camera)]
+        spans = [(c.start_ms, c.end_ms) for c in plan.expressions]
+        spans += [(c.start_ms, c.end_ms) for c in plan.gaze]
+        spans += [(c.start_ms, c.end_ms) for c in plan.camera]
         spans += [(u.start_ms, u.end_ms) for u in plan.utterances]
         if any(start < shift and end > ends for start, end in spans):
             return None

@@ -343,8 +343,9 @@ class _Faces:
     faces counted (:class:`~facelib.tracking.mediapipe.FaceCounter`) on every tenth frame,
     on each after one with several, back over the frames since the last count when one finds
     several, and where the face is found after none; the same landmarks, at about three
-    quarters of the cost of the face mesh looking for two faces in every frame. Where the face is found
-    beside others the rest is tracked looking for ``max_faces``, keeping the largest face or
+    quarters of the cost of the face mesh looking for two faces in every frame. Where the
+    face is found beside others the rest is tracked looking for ``max_faces``, keeping the
+    largest face or
     the one overlapping the face kept before most (:mod:`~facelib.tracking.mediapipe`), as
     one face mesh looking for several would throughout. ``max_faces`` 1: no counting."""
 

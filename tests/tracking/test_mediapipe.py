@@ -45,17 +45,22 @@ def test_two_faces_keeps_the_largest(default_head_render):
     assert found.box[2] < 640  # the big face, on the left half
 
 
+def _small_then_both(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(480, 1280, 3)`` frames: ``image`` small on the right half, and the same with
+    ``image`` at full size on the left half beside it."""
+    from PIL import Image
+
+    alone = np.zeros((480, 1280, 3), np.uint8)
+    alone[60:420, 720:1200] = np.asarray(Image.fromarray(image).resize((480, 360)))
+    joined = alone.copy()
+    joined[:, :640] = image
+    return alone, joined
+
+
 def test_a_video_follows_its_face_when_a_larger_one_comes(default_head_render):
     """In a video the face tracked so far is kept when a second, larger one appears: a
     colleague leaning in closer does not take over the track."""
-    image, _ = default_head_render
-    from PIL import Image
-
-    small = np.asarray(Image.fromarray(image).resize((480, 360)))
-    alone = np.zeros((480, 1280, 3), np.uint8)
-    alone[60:420, 720:1200] = small
-    joined = alone.copy()
-    joined[:, :640] = image
+    alone, joined = _small_then_both(default_head_render[0])
     with FaceMeshTracker(video=True, max_faces=3) as tracker:
         found = [tracker.detect(frame) for frame in [alone] * 3 + [joined] * 3]
     assert all(f is not None for f in found)
@@ -68,16 +73,9 @@ def test_faces_counted_on_some_frames_name_them_all(default_head_render):
     coming after the first is counted on every frame it is in (back from the count that
     finds it), and the first is kept; two faces where the face is first found: the track
     looks for two from there, keeping the largest, as before."""
-    from PIL import Image
-
     from facelib.tracking.video import _COUNT_EVERY, _Faces
 
-    image, _ = default_head_render
-    small = np.asarray(Image.fromarray(image).resize((480, 360)))
-    alone = np.zeros((480, 1280, 3), np.uint8)
-    alone[60:420, 720:1200] = small
-    joined = alone.copy()
-    joined[:, :640] = image
+    alone, joined = _small_then_both(default_head_render[0])
     for frames, counts, right in (([alone] * (_COUNT_EVERY + 2) + [joined] * 3,
                                    [1] * (_COUNT_EVERY + 2) + [2] * 3, True),
                                   ([joined] * 3, [2] * 3, False)):
