@@ -142,19 +142,16 @@ void main()
     if (dot(n, v) < 0.0) {
         n = -n;
     }
-    base *= 0.8 + 0.4 * luck;
+    base *= 0.72 + 0.56 * luck;
     vec3 t1 = normalize(t + float(HAIR_SHIFT) * n);
     vec3 t2 = normalize(t - float(HAIR_SHIFT) * n);
     for (int i = 0; i < n_directional_lights; i++) {
         vec3 l = -directional_lights[i].direction;  // unit: a rigid pose's -z axis
         vec3 radiance = directional_lights[i].color * directional_lights[i].intensity;
         float nl = dot(n, l);
-        float tl = dot(t, l);
-        float lit = smoothstep(-0.1, 0.4, nl);
-        // Kajiya-Kay diffuse (sin of strand and light), softened by the card's side so
-        // that a lock away from the light stays darker but no card reads as a flat facet
-        diffuse += radiance * sqrt(max(1.0 - tl * tl, 0.0)) * (0.45 + 0.55 * lit);
+        diffuse += radiance * max((nl + wrap) / (1.0 + wrap), 0.0);
         vec3 h = normalize(l + v);
+        float lit = smoothstep(-0.1, 0.4, nl);
         specular += radiance * lit * (float(HAIR_SHINE) * strand_lobe(t1, h, float(HAIR_GLOSS))
                                       + float(HAIR_SHEEN) * strand_lobe(t2, h, 0.25 * float(HAIR_GLOSS)) * 4.0 * base);
     }
