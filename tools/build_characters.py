@@ -276,19 +276,27 @@ def similarity(old: np.ndarray, new: np.ndarray) -> tuple[float, np.ndarray]:
 
 
 def loop_of(verts: np.ndarray, triangles: np.ndarray, skin: tuple[int, int]) -> np.ndarray:
-    """The skin's loop at the neck's end: centre ``(3,)``, then half-width and half-depth
-    (metres), as ``(5,)``."""
+    """The skin's loop at the neck's end: centre ``(3,)``, half-width and half-depth, and its
+    tilt (how much higher the front is than the back's mean, half of it: ``y ~ y0 + tilt
+    cos(theta)``, theta from the front), metres, as ``(6,)``."""
     loop = verts[build_bust.seam_loop(verts, triangles, skin)]
-    return np.concatenate([loop.mean(0), np.ptp(loop[:, [0, 2]], axis=0) / 2])
+    theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
+    basis = np.stack([np.ones_like(theta), np.cos(theta)], 1)
+    tilt = np.linalg.lstsq(basis, loop[:, 1], rcond=None)[0][1]
+    return np.concatenate([loop.mean(0), np.ptp(loop[:, [0, 2]], axis=0) / 2, [tilt]])
 
 
 def rings_for(s: float, *, old: np.ndarray, new: np.ndarray, shoulders: float) -> np.ndarray:
     """The default bust's rings for a character whose skin is ``s`` times the default's
     and whose neck loop is ``new`` (``old``: the default's; see :func:`loop_of`): heights and
     depths kept relative to the loop (scaled by ``s``), the neck rings (0-2) as thick across
-    as the loop, turning into ``s`` times ``shoulders`` from ring 5 on."""
+    and as tilted as the loop, turning into ``s`` times ``shoulders`` and the default's tilt
+    from ring 5 on (a male neck's loop dips 20 mm lower at the front than the default's: with
+    the default's tilt the bust's front rose above the loop and folded back down, a crease
+    across the throat)."""
     rings = build_bust.RINGS.copy()
-    neck = new[3:] / old[3:]
+    neck = new[3:5] / old[3:5]
+    extra_tilt = new[5] - s * old[5]
     for k, ring in enumerate(rings):
         w = float(np.clip((k - 2) / 3, 0, 1))
         across = (1 - w) * neck + w * s * np.array([shoulders, 1.0])
@@ -296,7 +304,8 @@ def rings_for(s: float, *, old: np.ndarray, new: np.ndarray, shoulders: float) -
         height = new[1] + s * (y - old[1])
         if k >= len(rings) - len(BUST_END):  # far enough down for long hair's framing
             height = min(height, BUST_END[k - len(rings)])
-        ring[:] = (height, s * tilt, a * across[0], b * across[1], n, new[2] + s * (z - old[2]))
+        ring[:] = (height, s * tilt + (1 - w) * extra_tilt, a * across[0], b * across[1], n,
+                   new[2] + s * (z - old[2]))
     return rings
 
 
