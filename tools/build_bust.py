@@ -110,9 +110,34 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
     return np.array(out)
 
 
-def surface(controls: np.ndarray) -> CubicSpline:
-    """The bust surface as a spline in ring index (0 = the loop) per column."""
-    return CubicSpline(np.arange(len(controls)), controls, axis=0, bc_type="natural")
+def surface(controls: np.ndarray, start: np.ndarray | None = None) -> CubicSpline:
+    """The bust surface as a spline in ring index (0 = the loop) per column; ``start``: its
+    derivative at the loop ``(S, 3)`` (metres per ring), else a natural end there."""
+    ends = "natural" if start is None else ((1, start), (2, np.zeros(controls.shape[1:])))
+    return CubicSpline(np.arange(len(controls)), controls, axis=0, bc_type=ends)
+
+
+def neck_tangents(vertices: np.ndarray, triangles: np.ndarray, loop_ids: np.ndarray,
+                  step: np.ndarray) -> np.ndarray:
+    """``(S, 3)`` the head's neck continued past its loop: at each loop vertex the direction
+    from its neighbours above (the along-loop part taken out), ``step`` ``(S,)`` long."""
+    on_loop = np.zeros(len(vertices), bool)
+    on_loop[loop_ids] = True
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    edges = np.concatenate([edges, edges[:, ::-1]])
+    edges = edges[on_loop[edges[:, 0]] & ~on_loop[edges[:, 1]]]
+    position = np.full(len(vertices), -1)
+    position[loop_ids] = np.arange(len(loop_ids))
+    above = np.zeros((len(loop_ids), 3))
+    np.add.at(above, position[edges[:, 0]], vertices[edges[:, 1]])
+    counts = np.bincount(position[edges[:, 0]], minlength=len(loop_ids))
+    loop = vertices[loop_ids]
+    down = loop - above / np.maximum(counts, 1)[:, None]
+    along = np.roll(loop, -1, axis=0) - np.roll(loop, 1, axis=0)
+    along /= np.linalg.norm(along, axis=1, keepdims=True)
+    down -= np.einsum("ij,ij->i", down, along)[:, None] * along
+    down /= np.linalg.norm(down, axis=1, keepdims=True)
+    return down * step[:, None]
 
 
 def quads(rows: np.ndarray) -> np.ndarray:
@@ -195,12 +220,17 @@ def bake_ao(head_v: np.ndarray, head_t: np.ndarray, bust_v: np.ndarray,
 
 
 def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RINGS,
-          garment_rgb: np.ndarray = GARMENT_RGB, collar_rgb: np.ndarray = COLLAR_RGB
-          ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+          garment_rgb: np.ndarray = GARMENT_RGB, collar_rgb: np.ndarray = COLLAR_RGB,
+          along_neck: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
     """The bust's arrays and the head's (possibly unfaded) vertex colours. ``head``: the
     head's ``vertices``, ``triangles``, ``vertex_colors``, ``vertex_ao`` and ``skin`` (its
     vertex range), else the default head's; ``rings``: the cross-sections (``RINGS``);
-    the garment's and collar's sRGB colours (tools/build_characters.py varies all three)."""
+    the garment's and collar's sRGB colours (tools/build_characters.py varies all three);
+    ``along_neck``: the bust leaves the loop in the direction the head's neck arrives at it
+    (:func:`neck_tangents`) instead of a natural spline end (the characters: on necks whose
+    loop dips at the front the natural end rose above the loop there, a fold that rendered
+    as a dotted line across the throat; the default bust, whose rings were tuned on its own
+    neck, keeps the natural end)."""
     given = head is not None
     if head is None:
         doc = json.loads((HEAD / "default_head.json").read_text())
@@ -215,7 +245,12 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
     loop_ids = seam_loop(head_v, head_t, skin)
     loop = head_v[loop_ids].astype(np.float64)
     theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
-    spline = surface(ring_points(loop, rings))
+    controls = ring_points(loop, rings)
+    start = None
+    if along_neck:
+        step = np.linalg.norm(controls[1] - controls[0], axis=1)
+        start = neck_tangents(head_v.astype(np.float64), head_t, loop_ids, step)
+    spline = surface(controls, start)
     base, n_cols = len(head_v), len(loop_ids)
     skin_v = spline(SAMPLES).reshape(-1, 3)
     rows = np.vstack([loop_ids, base + np.arange(skin_v.shape[0]).reshape(len(SAMPLES), n_cols)])

@@ -1,6 +1,6 @@
 """Hair and bust of the default head, as rendered: no scalp skin shows above the hairline in
 any style at head and bust framing (front and a 30 degree head turn), and the neck shows no
-seam where the bust meets the head."""
+seam where the bust meets the head, on the default head and every character."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from facelib.engine import load_face
+from facelib.engine.characters import character_names
 from facelib.mpeg4.tables import fap
 from facelib.rendering.scene import FaceRenderer, vertex_normals
 
@@ -86,12 +87,18 @@ def test_hair_turns_with_the_head_exactly() -> None:
         np.testing.assert_allclose(moved[ids], expected, atol=2e-6)
 
 
-def test_neck_shows_no_seam_at_a_30_degree_turn() -> None:
-    face = load_face(None, hair="short")
+@pytest.mark.parametrize("name", [
+    pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=(
+        "a one-pixel light line along ada's seam (steps of 11 levels): the bust's first "
+        "row lies 0.4 mm below the loop and 0.3 mm out, a ledge lit from above")))
+    if name == "ada" else name for name in (None, *character_names())])
+def test_neck_shows_no_seam_at_a_30_degree_turn(name) -> None:
+    """The default head and every character (whose neck loops dip lower at the front)."""
+    face = load_face(name, hair=None if name else "short")  # a character in its own hair
     moved = _yawed(face, 30.0)
     with FaceRenderer(face, width=480, height=360, framing="bust") as renderer:
         image = renderer.frame(moved).astype(float)
-        seam = np.load(str(_bust_file()))["seam"]
+        seam = np.load(str(_bust_file(name)))["seam"]
         front = seam[np.argsort(-face.vertices[seam, 2])[:5]]
         column, seam_row = np.round(renderer.project(moved[front]).mean(0)).astype(int)
         chin_row = int(renderer.project(moved[face.feature_points["2.1"]])[0, 1])
@@ -102,7 +109,7 @@ def test_neck_shows_no_seam_at_a_30_degree_turn() -> None:
     assert near.max() < max(8.0, 2.5 * np.median(neck)), (near, np.median(neck))
 
 
-def _bust_file():
+def _bust_file(name: str | None):
     from facelib import data
 
-    return data.path("head/default_bust.npz")
+    return data.path(f"head/{name or 'default'}_bust.npz")
