@@ -277,8 +277,8 @@ def similarity(old: np.ndarray, new: np.ndarray) -> tuple[float, np.ndarray]:
 
 def loop_of(verts: np.ndarray, triangles: np.ndarray, skin: tuple[int, int]) -> np.ndarray:
     """The skin's loop at the neck's end: centre ``(3,)``, half-width and half-depth, and its
-    tilt (how much higher the front is than the back's mean, half of it: ``y ~ y0 + tilt
-    cos(theta)``, theta from the front), metres, as ``(6,)``."""
+    tilt (``y ~ y0 + tilt cos(theta)``, theta from the front: negative when the front is
+    lower), metres, as ``(6,)``."""
     loop = verts[build_bust.seam_loop(verts, triangles, skin)]
     theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
     basis = np.stack([np.ones_like(theta), np.cos(theta)], 1)
