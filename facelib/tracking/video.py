@@ -15,8 +15,10 @@ import subprocess
 import tempfile
 import warnings
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import suppress
 from dataclasses import dataclass
+from functools import partial
 from itertools import islice
 from pathlib import Path
 from typing import Any
@@ -37,6 +39,7 @@ from facelib.tracking.mediapipe import (
 )
 from facelib.tracking.neutral import NeutralChoice, neutral_news
 from facelib.tracking.observation import ObservationModel, default_observation
+from facelib.tracking.overlap import InOrder, read_ahead
 
 log = logging.getLogger("facelib.tracking")
 
@@ -184,11 +187,13 @@ def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.nda
 def _decode(path: Path, fps: float, width: int, height: int) -> Iterator[np.ndarray]:
     """``(height, width, 3) uint8`` RGB frames of ``path`` at ``fps`` from one ffmpeg, read
     from a pipe that holds a whole frame (Linux: with the default 64 KiB one the switches
-    between ffmpeg and this process cost an eighth of ffmpeg's own decoding time)."""
+    between ffmpeg and this process cost an eighth of ffmpeg's own decoding time), decoding
+    on one thread (ffmpeg's frame threads took the core MediaPipe runs on in bursts: the
+    whole path ran at 0.64 of MediaPipe's speed with them, 0.72 without)."""
     size = width * height * 3
     command = [_imageio_ffmpeg().get_ffmpeg_exe(), "-nostdin", "-hide_banner", "-loglevel",
-               "error", "-i", str(path), "-vf", f"fps={fps!r}", "-f", "rawvideo", "-pix_fmt",
-               "rgb24", "-"]
+               "error", "-threads", "1", "-i", str(path), "-vf", f"fps={fps!r}", "-f",
+               "rawvideo", "-pix_fmt", "rgb24", "-"]
     with tempfile.TemporaryFile() as errors, subprocess.Popen(
             command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=errors) as ffmpeg:
         assert ffmpeg.stdout is not None
@@ -355,59 +360,74 @@ class _Faces:
         """Faces seen per frame so far (0: no face found)."""
         self.mesh = FaceMeshTracker(video=True, max_faces=1)
         self.counter = FaceCounter() if max_faces > 1 else None
-        self.held: list[np.ndarray] = []  # the frames since the last count
+        self.held: list[tuple[int, np.ndarray]] = []  # the frames since the last count
         self.several = False  # the last count found several faces
         self.kept: np.ndarray | None = None  # the box of the face kept last
 
-    def detect(self, image: np.ndarray) -> FaceLandmarks | None:
-        """The next frame's face (:meth:`FaceMeshTracker.detect`)."""
+    def detect(self, image: np.ndarray, beside: InOrder) -> FaceLandmarks | None:
+        """The next frame's face (:meth:`FaceMeshTracker.detect`); its faces are counted on
+        ``beside``'s thread, or here, after the calls before, where the face is found after
+        none (the count decides whether to look for several from this frame on)."""
         found = self.mesh.detect(image)
+        index = len(self.counts)
         self.counts.append(0 if found is None else found.n_faces)
         if self.counter is not None:
-            found = self._count(image, found)
+            if found is not None and (index == 0 or not self.counts[index - 1]):
+                beside.wait()
+                found = self._acquired(image, found)
+            else:
+                beside.submit(partial(self._count, index, image))
         if found is not None:
             self.kept = found.box
         return found
 
-    def _count(self, image: np.ndarray, found: FaceLandmarks | None) -> FaceLandmarks | None:
+    def _acquired(self, image: np.ndarray, found: FaceLandmarks) -> FaceLandmarks | None:
+        """Count the faces of the last frame, where the face is found after none: beside
+        others, the face mesh looks for several from here on."""
         assert self.counter is not None
-        acquired = found is not None and (len(self.counts) == 1 or not self.counts[-2])
-        if not (acquired or self.several or len(self.held) + 1 >= _COUNT_EVERY):
-            self.held.append(image)
-            return found
         n = self.counter.count(image)
-        if n > 1 and acquired:  # found beside others: look for several from here on
-            self.counter.close()
-            self.counter = None
-            self.mesh.close()
-            self.mesh = FaceMeshTracker(video=True, max_faces=self.max_faces,
-                                        follow=self.kept)
-            found = self.mesh.detect(image)
-            self.counts[-1] = 0 if found is None else found.n_faces
+        if n < 2:
+            self._counted(len(self.counts) - 1, n)
             return found
-        self._counted(n)
-        return found
+        self.counter.close()
+        self.counter = None
+        self.mesh.close()
+        self.mesh = FaceMeshTracker(video=True, max_faces=self.max_faces, follow=self.kept)
+        again = self.mesh.detect(image)
+        self.counts[-1] = 0 if again is None else again.n_faces
+        return again
 
-    def _counted(self, n: int) -> None:
-        """The last frame has ``n`` faces: so have those held before it that also have
+    def _count(self, index: int, image: np.ndarray) -> None:
+        """Frame ``index`` (``image``): counted if due (ten frames on, or after one with
+        several), else held until the next count."""
+        if self.counter is None:  # looking for several since
+            return
+        if self.several or len(self.held) + 1 >= _COUNT_EVERY:
+            self._counted(index, self.counter.count(image))
+        else:
+            self.held.append((index, image))
+
+    def _counted(self, index: int, n: int) -> None:
+        """Frame ``index`` has ``n`` faces: so have those held before it that also have
         several (counted back to one that has not)."""
         assert self.counter is not None
         if n > 1 and not self.several:
-            for back, held in enumerate(reversed(self.held), start=2):
-                earlier = self.counter.count(held)
-                if earlier < 2:
+            for earlier, held in reversed(self.held):
+                found = self.counter.count(held)
+                if found < 2:
                     break
-                self._set(-back, earlier)
-        self._set(-1, n)
+                self._set(earlier, found)
+        self._set(index, n)
         self.several, self.held = n > 1, []
 
     def finish(self) -> None:
         """Count the last frame if it was not (the video ended between counts)."""
         if self.counter is not None and self.held:
-            self._counted(self.counter.count(self.held.pop()))
+            index, image = self.held.pop()
+            self._counted(index, self.counter.count(image))
 
     def _set(self, frame: int, n: int) -> None:
-        """Count ``n`` faces in ``frame`` (from the end) where the face mesh found one."""
+        """Count ``n`` faces in ``frame`` where the face mesh found one."""
         if self.counts[frame]:
             self.counts[frame] = min(max(n, 1), self.max_faces)
 
@@ -416,6 +436,15 @@ class _Faces:
         self.mesh.close()
         if self.counter is not None:
             self.counter.close()
+
+
+def _after_landmarks(image: np.ndarray, points: np.ndarray, box: np.ndarray | None,
+                     light: list[float], brows: _BrowPass | None) -> None:
+    """A frame's work after its ``(478, 3)`` landmarks: the brows' registration and the
+    face's light (appended to ``light``; NaN where ``box`` is None: no face)."""
+    if brows is not None:
+        brows.add(image, points)
+    light.append(float("nan") if box is None else _face_light(image, box))
 
 
 def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
@@ -428,23 +457,32 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
     Raises TrackingError if the video has no frames or no face in any frame; warns
     (:class:`TrackingWarning`) naming the frames with several faces.
     """
-    info, frames = read_video(path)
     limit = None if max_frames is None else check_count("max_frames", max_frames, low=1)
-    faces = _Faces(check_count("max_faces", max_faces, low=1))
+    wanted = check_count("max_faces", max_faces, low=1)
+    with ThreadPoolExecutor(1) as pool:  # ffmpeg probes the video while the graphs load
+        probe = pool.submit(read_video, path)
+        faces = _Faces(wanted)
+        try:
+            info, decoded = probe.result()
+        except BaseException:
+            faces.close()
+            raise
     points: list[np.ndarray] = []
     light: list[float] = []
     lost = np.full((N_LANDMARKS, 3), np.nan)
+    frames = read_ahead(decoded)
     try:
-        for i, image in enumerate(frames):
-            if limit is not None and i >= limit:
-                break
-            found = faces.detect(image)
-            points.append(lost if found is None else found.points)
-            if _brows is not None:
-                _brows.add(image, points[-1])
-            light.append(float("nan") if found is None else _face_light(image, found.box))
-        faces.finish()
+        with InOrder() as beside:  # the work after the landmarks, beside the next frame's
+            for i, image in enumerate(frames):
+                if limit is not None and i >= limit:
+                    break
+                found = faces.detect(image, beside)
+                points.append(lost if found is None else found.points)
+                beside.submit(partial(_after_landmarks, image, points[-1],
+                                      None if found is None else found.box, light, _brows))
+            beside.submit(faces.finish)
     finally:
+        frames.close()
         faces.close()
     if not points:
         raise TrackingError("the video has no frames", path=Path(path))

@@ -73,6 +73,7 @@ def test_faces_counted_on_some_frames_name_them_all(default_head_render):
     coming after the first is counted on every frame it is in (back from the count that
     finds it), and the first is kept; two faces where the face is first found: the track
     looks for two from there, keeping the largest, as before."""
+    from facelib.tracking.overlap import InOrder
     from facelib.tracking.video import _COUNT_EVERY, _Faces
 
     alone, joined = _small_then_both(default_head_render[0])
@@ -81,8 +82,9 @@ def test_faces_counted_on_some_frames_name_them_all(default_head_render):
                                   ([joined] * 3, [2] * 3, False)):
         faces = _Faces(2)
         try:
-            found = [faces.detect(frame) for frame in frames]
-            faces.finish()
+            with InOrder() as beside:  # the counts run on its thread, as in track_video
+                found = [faces.detect(frame, beside) for frame in frames]
+                beside.submit(faces.finish)
         finally:
             faces.close()
         assert faces.counts == counts
