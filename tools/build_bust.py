@@ -91,12 +91,19 @@ def superellipse_radius(theta: np.ndarray, a: float, b: float, n: float) -> np.n
     return (np.power(s / a, n) + np.power(c / b, n)) ** (-1.0 / n)
 
 
-def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
-    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``."""
+def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS, *,
+                loop_heights: bool = False) -> np.ndarray:
+    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``.
+    ``loop_heights``: the first rings also keep the loop's heights where they depart from
+    a tilted plane (``LOOP_SHAPE`` of them: a throat whose loop dips in a V at the front
+    would otherwise have ring 0 above the loop there, a fold)."""
     centre = np.array([0.0, 0.0, loop[:, 2].mean()])
     rel = loop - centre
     theta = np.arctan2(rel[:, 0], rel[:, 2])
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
+    basis = np.stack([np.ones_like(theta), np.cos(theta)], 1)
+    plane = basis @ np.linalg.lstsq(basis, loop[:, 1], rcond=None)[0]
+    residual = loop[:, 1] - plane if loop_heights else np.zeros(len(loop))
     out = [loop]
     for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
         r = superellipse_radius(theta, a, b, n)
@@ -106,8 +113,13 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
             r = w * r_loop + (1 - w) * r
             zc = w * centre[2] + (1 - w) * ring_z
         heights = y + tilt * np.cos(theta)
+        if k < len(LOOP_SHAPE):
+            heights = heights + LOOP_SHAPE[k] * residual
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
-    return np.array(out)
+    out = np.array(out)
+    if loop_heights:  # ring 0 a quarter of the way down to ring 1 at least, in every column
+        out[1, :, 1] = np.minimum(out[1, :, 1], loop[:, 1] - 0.25 * (loop[:, 1] - out[2, :, 1]))
+    return out
 
 
 def surface(controls: np.ndarray, start: np.ndarray | None = None) -> CubicSpline:
@@ -245,7 +257,7 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
     loop_ids = seam_loop(head_v, head_t, skin)
     loop = head_v[loop_ids].astype(np.float64)
     theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
-    controls = ring_points(loop, rings)
+    controls = ring_points(loop, rings, loop_heights=along_neck)
     start = None
     if along_neck:
         step = np.linalg.norm(controls[1] - controls[0], axis=1)
