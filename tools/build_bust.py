@@ -59,6 +59,7 @@ RINGS = np.array([
     (-0.440, 0.000, 0.166, 0.113, 2.5, -0.008),
 ])
 LOOP_SHAPE = (0.7, 0.35)  # how much of the loop's own shape rings 1 and 2 keep
+RING0_MIN_DROP = 0.25  # along_neck: ring 0 at least this share of the way down to ring 1
 SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
 NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
 GARMENT_OFFSET = 0.004  # metres outside the skin
@@ -101,9 +102,10 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS, *,
     rel = loop - centre
     theta = np.arctan2(rel[:, 0], rel[:, 2])
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
-    basis = np.stack([np.ones_like(theta), np.cos(theta)], 1)
-    plane = basis @ np.linalg.lstsq(basis, loop[:, 1], rcond=None)[0]
-    residual = loop[:, 1] - plane if loop_heights else np.zeros(len(loop))
+    residual = np.zeros(len(loop))
+    if loop_heights:
+        height, tilt = tilted_plane(loop)
+        residual = loop[:, 1] - (height + tilt * np.cos(theta))
     out = [loop]
     for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
         r = superellipse_radius(theta, a, b, n)
@@ -117,9 +119,20 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS, *,
             heights = heights + LOOP_SHAPE[k] * residual
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
     out = np.array(out)
-    if loop_heights:  # ring 0 a quarter of the way down to ring 1 at least, in every column
-        out[1, :, 1] = np.minimum(out[1, :, 1], loop[:, 1] - 0.25 * (loop[:, 1] - out[2, :, 1]))
+    if loop_heights:  # ring 0 part of the way down to ring 1 at least, in every column
+        drop = RING0_MIN_DROP * (loop[:, 1] - out[2, :, 1])
+        out[1, :, 1] = np.minimum(out[1, :, 1], loop[:, 1] - drop)
     return out
+
+
+def tilted_plane(loop: np.ndarray) -> tuple[float, float]:
+    """The loop's ``(S, 3)`` heights as a tilted plane, least squares: ``(y0, tilt)`` with
+    ``y ~ y0 + tilt cos(theta)``, theta about the vertical axis from the front (metres;
+    the tilt negative when the front is lower)."""
+    theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
+    basis = np.stack([np.ones_like(theta), np.cos(theta)], 1)
+    y0, tilt = np.linalg.lstsq(basis, loop[:, 1], rcond=None)[0]
+    return float(y0), float(tilt)
 
 
 def surface(controls: np.ndarray, start: np.ndarray | None = None) -> CubicSpline:

@@ -280,9 +280,7 @@ def loop_of(verts: np.ndarray, triangles: np.ndarray, skin: tuple[int, int]) -> 
     tilt (``y ~ y0 + tilt cos(theta)``, theta from the front: negative when the front is
     lower), metres, as ``(6,)``."""
     loop = verts[build_bust.seam_loop(verts, triangles, skin)]
-    theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
-    basis = np.stack([np.ones_like(theta), np.cos(theta)], 1)
-    tilt = np.linalg.lstsq(basis, loop[:, 1], rcond=None)[0][1]
+    tilt = build_bust.tilted_plane(loop)[1]
     return np.concatenate([loop.mean(0), np.ptp(loop[:, [0, 2]], axis=0) / 2, [tilt]])
 
 

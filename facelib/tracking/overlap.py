@@ -37,14 +37,12 @@ def read_ahead(items: Iterator[T], *, depth: int = 4) -> Generator[T, None, None
     def fill() -> None:
         try:
             for item in items:
-                while not stop.is_set():
-                    try:
+                while True:  # wait for room, or for the caller to stop
+                    if stop.is_set():
+                        return
+                    with suppress(queue.Full):
                         ahead.put(item, timeout=0.05)
                         break
-                    except queue.Full:
-                        continue
-                if stop.is_set():
-                    return
             ahead.put(_DONE)
         except BaseException as exc:  # noqa: BLE001 (raised in the caller's thread)
             ahead.put(exc)
@@ -70,8 +68,9 @@ def read_ahead(items: Iterator[T], *, depth: int = 4) -> Generator[T, None, None
 class InOrder:
     """Calls run one at a time, in the order given, on one worker thread, at most ``depth``
     waiting (the caller waits beyond that). The first exception a call raises is raised
-    by :meth:`join` (the calls after it are skipped). Use as a context manager: leaving it
-    joins the worker (and on an error in the caller, drops the calls not yet run)."""
+    by :meth:`wait` or :meth:`join` (the calls after it are skipped). Use as a context
+    manager: leaving it joins the worker (and on an error in the caller, drops the calls not
+    yet run)."""
 
     def __init__(self, *, depth: int = 8) -> None:
         self._calls: queue.Queue[Any] = queue.Queue(maxsize=depth)
@@ -100,15 +99,19 @@ class InOrder:
         """Wait for the calls submitted so far (the worker stays); raise the first
         exception one raised."""
         self._calls.join()
-        error, self._error = self._error, None
-        if error is not None:
-            raise error
+        self._raise()
 
     def join(self) -> None:
         """Wait for every call submitted; raise the first exception one raised."""
+        self._stop()
+        self._raise()
+
+    def _stop(self) -> None:
         if self._thread.is_alive():
             self._calls.put(_DONE)
             self._thread.join()
+
+    def _raise(self) -> None:
         error, self._error = self._error, None
         if error is not None:
             raise error
@@ -119,8 +122,6 @@ class InOrder:
     def __exit__(self, kind: type[BaseException] | None, *_: object) -> None:
         if kind is None:
             self.join()
-            return
-        self._dropping = True  # the caller failed: skip what is left, then stop
-        if self._thread.is_alive():
-            self._calls.put(_DONE)
-            self._thread.join()
+        else:  # the caller failed: skip what is left, stop, and let its error go on
+            self._dropping = True
+            self._stop()
