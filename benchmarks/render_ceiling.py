@@ -53,6 +53,50 @@ void main() {
 """
 
 
+class OSMesaContext:
+    """An OSMesa context made current on a ``width x height`` RGBA buffer, as pyrender's
+    OSMesa platform makes it (core profile 3.3, 24 depth bits), and the function loader
+    ``moderngl.init_context`` asks for: the ceiling on the context type facelib renders on
+    by default on a machine without a GPU (PyOpenGL is not imported in this process)."""
+
+    def __init__(self, width: int, height: int):
+        import ctypes
+
+        lib = ctypes.CDLL("libOSMesa.so.8")
+        lib.OSMesaCreateContextAttribs.restype = ctypes.c_void_p
+        lib.OSMesaCreateContextAttribs.argtypes = [ctypes.POINTER(ctypes.c_int),
+                                                   ctypes.c_void_p]
+        lib.OSMesaMakeCurrent.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint,
+                                          ctypes.c_int, ctypes.c_int]
+        lib.OSMesaGetProcAddress.restype = ctypes.c_void_p
+        lib.OSMesaGetProcAddress.argtypes = [ctypes.c_char_p]
+        lib.OSMesaDestroyContext.argtypes = [ctypes.c_void_p]
+        # OSMESA_FORMAT RGBA, OSMESA_DEPTH_BITS 24, OSMESA_PROFILE core, version 3.3
+        attributes = [0x22, 0x1908, 0x30, 24, 0x33, 0x34, 0x36, 3, 0x37, 3, 0]
+        self.lib = lib
+        self.context = lib.OSMesaCreateContextAttribs(
+            (ctypes.c_int * len(attributes))(*attributes), None)
+        if not self.context:
+            raise RuntimeError("OSMesaCreateContextAttribs failed")
+        self.buffer = (ctypes.c_ubyte * (width * height * 4))()
+        if not lib.OSMesaMakeCurrent(self.context, self.buffer, 0x1401, width, height):
+            raise RuntimeError("OSMesaMakeCurrent failed")
+
+    def load_opengl_function(self, name: str) -> int:
+        return self.lib.OSMesaGetProcAddress(name.encode()) or 0
+
+    def release(self) -> None:
+        if self.context:
+            self.lib.OSMesaDestroyContext(self.context)
+            self.context = None
+
+    def __enter__(self) -> None:
+        pass
+
+    def __exit__(self, *args: object) -> None:
+        pass
+
+
 class Ceiling:
     """Renders ``(V, 3)`` vertices of a mesh to ``(height, width, 3) uint8``.
 
@@ -61,10 +105,15 @@ class Ceiling:
     """
 
     def __init__(self, triangles: np.ndarray, colours: np.ndarray, mvp: np.ndarray, *,
-                 width: int, height: int, samples: int = 4):
+                 width: int, height: int, samples: int = 4, backend: str = "egl"):
         import moderngl
 
-        self.ctx: Any = moderngl.create_standalone_context(backend="egl")
+        if backend == "osmesa":
+            self._osmesa = OSMesaContext(width, height)
+            moderngl.init_context(self._osmesa)
+            self.ctx: Any = moderngl.get_context()
+        else:
+            self.ctx = moderngl.create_standalone_context(backend="egl")
         self.renderer = self.ctx.info["GL_RENDERER"]
         self.width, self.height = width, height
         self.triangles = np.asarray(triangles, np.int64)
@@ -101,9 +150,12 @@ class Ceiling:
 
     def close(self) -> None:
         self.ctx.release()
+        if getattr(self, "_osmesa", None) is not None:
+            self._osmesa.release()
 
 
-def serve(label: str, size: str, samples: int, frames: int, mvp: np.ndarray) -> None:
+def serve(label: str, size: str, samples: int, frames: int, mvp: np.ndarray, *,
+          backend: str = "egl") -> None:
     """The child process's loop (see the module's docs); ``mvp`` ``(4, 4)`` the face
     renderer's projection times view matrix."""
     from render_speed import _bare_face, _stream
@@ -114,8 +166,8 @@ def serve(label: str, size: str, samples: int, frames: int, mvp: np.ndarray) -> 
     face = _bare_face() if label == "bare" else load_face(None)
     vertices = face.deform(_stream(frames / 25.0, 25))
     ceiling = Ceiling(face.triangles, face.vertex_colors, mvp, width=width, height=height,
-                      samples=samples)
-    print(ceiling.renderer, flush=True)
+                      samples=samples, backend=backend)
+    print(f"{backend}/{ceiling.renderer}", flush=True)
     ceiling.frame(vertices[0])
     for line in sys.stdin:
         command, _, argument = line.strip().partition(" ")
@@ -137,4 +189,5 @@ def serve(label: str, size: str, samples: int, frames: int, mvp: np.ndarray) -> 
 
 if __name__ == "__main__":
     serve(sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4]),
-          np.array([float(v) for v in sys.argv[5].split(",")]).reshape(4, 4))
+          np.array([float(v) for v in sys.argv[5].split(",")]).reshape(4, 4),
+          backend=sys.argv[6] if len(sys.argv) > 6 else "egl")

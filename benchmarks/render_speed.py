@@ -185,19 +185,10 @@ def _serve_shaders(renderer, folder: Path) -> None:
     """Make ``renderer`` (a FaceRenderer) draw with ``folder``'s face.vert and face.frag
     (an earlier version of facelib's shaders: ``git show main:facelib/data/shaders/...``),
     everything else the same, so a shader change is measured side by side in one process."""
-    cache = renderer._renderer._renderer._program_cache
-    served = cache.get_program
+    from facelib.rendering.scene import install_program_cache
 
-    def get_program(vertex_shader, fragment_shader, geometry_shader=None, defines=None):
-        if (vertex_shader, fragment_shader, geometry_shader) == ("mesh.vert", "mesh.frag",
-                                                                 None):
-            defines = dict(defines or {})
-            defines.update({k.upper(): float(v) for k, v in renderer.look.shading.items()})
-            vertex_shader = str(folder / "face.vert")
-            fragment_shader = str(folder / "face.frag")
-        return served(vertex_shader, fragment_shader, geometry_shader, defines)
-
-    cache.get_program = get_program
+    install_program_cache(renderer._pr, renderer._renderer._renderer, renderer.look,
+                          shaders=str(folder))
 
 
 def _side_by_side(renderers: dict, rounds: int, frames: int) -> dict:

@@ -27,6 +27,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
+from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Literal
 
@@ -35,6 +36,7 @@ import numpy as np
 from facelib import data
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import FaceModelError, ParameterError, RenderError
+from facelib.rendering.gl_state import install_opaque_blending, install_uniform_cache
 from facelib.rendering.normals import normal_operator, vertex_normals
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
@@ -379,8 +381,11 @@ def _shader_file(name: str) -> str:
     return str(data.path(f"shaders/{name}"))
 
 
-def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
-    """Give pyrender's ``renderer`` (a ``pyrender.Renderer``) facelib's program cache.
+def install_program_cache(pr: Any, renderer: Any, look: Look, *,
+                          shaders: str | None = None) -> None:
+    """Give pyrender's ``renderer`` (a ``pyrender.Renderer``) facelib's program cache
+    (``shaders``: a folder with other ``face.vert`` and ``face.frag`` to draw with, for
+    benchmarks; None: facelib's).
 
     It does two things. It serves facelib's face shader wherever pyrender asks for its
     mesh shader, with the look's ``shading`` numbers as ``#define``s (upper-cased names).
@@ -388,14 +393,21 @@ def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
     ``OpenGL.contextdata.getContext()``, which on OSMesa is a fresh ctypes pointer object
     each call, so every frame missed the cache, recompiled every shader and leaked the old
     programs (about 40% of the frame time at 640x480). A renderer has exactly one context.
+    Its programs set their uniforms through
+    :func:`facelib.rendering.gl_state.install_uniform_cache`, and pyrender draws opaque
+    materials with blending off (:func:`facelib.rendering.gl_state.install_opaque_blending`).
     """
+    install_opaque_blending(pr)
     base = pr.shader_program.ShaderProgramCache
     old = getattr(renderer, "_program_cache", None)
     if not isinstance(old, base):
         return
     # a look made before the skin's shading numbers existed draws smooth, unscattered skin
-    shading = {"WRINKLE_BUMP": 0.0, "WRINKLE_CREASE": 0.0, "SKIN_SCATTER": 0.0}
+    shading: dict[str, float | int] = {"WRINKLE_BUMP": 0.0, "WRINKLE_CREASE": 0.0,
+                                       "SKIN_SCATTER": 0.0}
     shading.update({name.upper(): float(value) for name, value in look.shading.items()})
+    # the face shader loops over the look's lights (as many as pyrender binds at most)
+    shading["LOOK_LIGHTS"] = min(len(look.lights), int(pr.constants.MAX_N_LIGHTS))
 
     class _FaceProgramCache(base):  # type: ignore[valid-type,misc]  # pyrender is untyped
         def __init__(self, shader_dir: str | None = None):
@@ -408,8 +420,12 @@ def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
             defines = dict(defines or {})
             if (vertex_shader, fragment_shader, geometry_shader) == ("mesh.vert", "mesh.frag",
                                                                      None):
-                vertex_shader, fragment_shader = _shader_file("face.vert"), _shader_file(
-                    "face.frag")
+                if shaders is None:
+                    vertex_shader, fragment_shader = (_shader_file("face.vert"),
+                                                      _shader_file("face.frag"))
+                else:
+                    vertex_shader = str(Path(shaders) / "face.vert")
+                    fragment_shader = str(Path(shaders) / "face.frag")
                 defines.update(shading)
             key = (vertex_shader, fragment_shader, geometry_shader,
                    tuple(sorted(defines.items())))
@@ -417,6 +433,7 @@ def install_program_cache(pr: Any, renderer: Any, look: Look) -> None:
             if program is None:
                 program = super().get_program(vertex_shader, fragment_shader,
                                               geometry_shader, defines)
+                install_uniform_cache(program)
                 self._by_source[key] = program
             return program
 

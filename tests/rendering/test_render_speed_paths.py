@@ -82,3 +82,34 @@ def test_the_fast_paths_keep_the_picture() -> None:
     changed = np.abs(uploaded - double).max(axis=2) > 8
     assert changed.mean() < 0.005
     assert np.abs(fast - double).mean() < 0.2
+
+
+@pytest.mark.render
+def test_cached_uniforms_and_opaque_blending_keep_the_picture() -> None:
+    import importlib
+
+    from OpenGL import GL
+
+    from facelib.engine import load_face
+    from facelib.rendering.scene import FaceRenderer
+
+    face = load_face(None)
+    values = np.zeros((3, 84), np.float32)
+    values[1, 2] = 300  # jaw open
+    values[2, 48] = 20000  # head yaw
+    poses = [face.deform_frame(v) for v in values]
+    module = importlib.import_module("pyrender.renderer")
+    with FaceRenderer(face, width=W, height=H, framing="head") as renderer:
+        fast = [renderer.frame(v, faps=f) for v, f in zip(poses, values, strict=True)]
+        assert not GL.glIsEnabled(GL.GL_BLEND)  # opaque parts drawn without blending
+        # pyrender's own uniform setting and blending, on the same programs
+        for program in renderer._renderer._renderer._program_cache._by_source.values():
+            del program.set_uniform
+        patched, module.glBlendFunc = module.glBlendFunc, GL.glBlendFunc
+        try:
+            plain = [renderer.frame(v, faps=f) for v, f in zip(poses, values, strict=True)]
+            assert GL.glIsEnabled(GL.GL_BLEND)
+        finally:
+            module.glBlendFunc = patched
+    for a, b in zip(fast, plain, strict=True):
+        assert np.array_equal(a, b)

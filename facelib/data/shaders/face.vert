@@ -24,7 +24,10 @@ out vec2 surface;
 layout(location = TANGENT_LOC) in vec4 tangent;
 out vec4 wrinkle;
 #endif
-layout(location = INST_M_LOC) in mat4 inst_m;
+// pyrender's per-instance model matrix (inst_m, at INST_M_LOC) is left out: facelib never
+// instances a primitive, so it is the identity, and M * identity is M exactly; dropping it
+// spares llvmpipe's vertex stage (on the main thread) a matrix product and four attribute
+// fetches a vertex
 
 uniform mat4 M;
 uniform mat4 V;
@@ -37,14 +40,13 @@ out float occlusion;
 
 void main()
 {
-    mat4 model = M * inst_m;
-    vec4 world = model * vec4(position, 1.0);
+    vec4 world = M * vec4(position, 1.0);
     gl_Position = P * V * world;
     world_position = world.xyz;
     // facelib's node poses are rigid (rotations and translations), so the model matrix's
     // upper 3x3 turns normals as it turns positions (face.frag normalises): no inverse per
     // vertex, which llvmpipe pays on the thread that also bins the triangles
-    world_normal = mat3(model) * normal;
+    world_normal = mat3(M) * normal;
 #ifdef TEXCOORD_0_LOC
     hair_uv = texcoord_0;
 #endif
