@@ -6,7 +6,8 @@ Run: ``PYTHONPATH=. python benchmarks/render_speed.py [--platform osmesa|egl] [-
 [--antialias auto|msaa|supersample|off] [--rounds 5] [--images DIR]`` (the platform must be
 chosen before OpenGL loads, so each platform is its own run). The anti-aliasing mode
 (``FaceRenderer(antialias=...)``) applies to every figure. The ceiling is
-``render_ceiling.py`` (moderngl on EGL, llvmpipe; ``pip install moderngl``, or it is left
+``render_ceiling.py`` (moderngl on llvmpipe through the same context type as this run, with
+its one-light shader and with facelib's face shader; ``pip install moderngl``, or it is left
 out).
 
 The CPU time a frame (all threads of the process, llvmpipe's included) varies less with
@@ -16,7 +17,10 @@ thread (vertex shading, binning) and rasterises on one thread per core, so on tw
 a frame takes about the main thread's CPU time plus half the rest: the "2 idle cores"
 estimate. "hair double-sided, all uploaded" is the renderer before the speed work of issue
 33 (every hair card drawn from both sides, every vertex uploaded and its normal recomputed
-each frame), kept to show what that work buys.
+each frame), kept to show what that work buys. "the ceiling's shader" is the face renderer
+drawing with the ceiling's one-light Lambert shader instead of facelib's (everything else
+the same): what is left of pyrender's own cost once the look's shading is taken out.
+``--side-by-side-only`` leaves out the mesh-update and MP4 figures.
 """
 
 from __future__ import annotations
@@ -111,18 +115,25 @@ class _InProcess:
 
 
 class _Child:
-    """The ceiling (render_ceiling.py) in a child process, measured there."""
+    """The ceiling (render_ceiling.py) in a child process, measured there: on the context
+    type this process renders on, with the minimal shader or facelib's (``shading``)."""
 
-    def __init__(self, label: str, args, samples: int, renderer):
+    def __init__(self, label: str, args, samples: int, renderer, shading: str = "lambert"):
+        import json
         import subprocess
         import sys
 
+        from facelib.rendering.platform import choose_platform
+
         here = Path(__file__).resolve().parent
         camera = renderer.scene.main_camera_node.camera
-        mvp = camera.get_projection_matrix(renderer.width, renderer.height) @ np.linalg.inv(
-            renderer.camera_pose)
+        config = {
+            "P": camera.get_projection_matrix(renderer.width, renderer.height).tolist(),
+            "V": np.linalg.inv(renderer.camera_pose).tolist(),
+            "position": renderer.camera_pose[:3, 3].tolist(),
+            "backend": choose_platform(), "shading": shading}
         command = [sys.executable, str(here / "render_ceiling.py"), label, args.size,
-                   str(samples), str(args.frames), ",".join(repr(float(v)) for v in mvp.ravel())]
+                   str(samples), str(args.frames), json.dumps(config)]
         self.process = subprocess.Popen(
             command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
             env={**os.environ, "PYTHONPATH": os.pathsep.join(
@@ -153,20 +164,60 @@ class _Child:
         self.process.wait()
 
 
+# the ceiling's shader (render_ceiling.py: one Lambert light, no gamma) where pyrender's
+# attributes and uniforms are, for the face renderer drawn with it ("the ceiling's shader")
+_LAMBERT_VERT = """#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = NORMAL_LOC) in vec3 normal;
+#ifdef COLOR_0_LOC
+layout(location = COLOR_0_LOC) in vec4 color_0;
+#endif
+uniform mat4 M;
+uniform mat4 V;
+uniform mat4 P;
+out vec3 n;
+out vec3 albedo;
+void main() {
+    gl_Position = P * V * (M * vec4(position, 1.0));
+    n = mat3(M) * normal;
+#ifdef COLOR_0_LOC
+    albedo = color_0.rgb;
+#else
+    albedo = vec3(0.8);
+#endif
+}
+"""
+
+
+def _lambert_shaders() -> Path:
+    """A temporary folder with the ceiling's shader as face.vert and face.frag."""
+    from render_ceiling import FRAGMENT
+
+    folder = Path(tempfile.mkdtemp())
+    (folder / "face.vert").write_text(_LAMBERT_VERT)
+    (folder / "face.frag").write_text(FRAGMENT)
+    return folder
+
+
 def _renderers(faces: dict, stream, args, width: int, height: int) -> dict:
-    """name -> measured renderer: per face, the FaceRenderer, for the default face also the
-    renderer before issue 33's speed work, and the ceiling."""
+    """name -> measured renderer: per face, the FaceRenderer, the same drawn with the
+    ceiling's shader, for the default face also the renderer before issue 33's speed work,
+    and the ceiling with its own shader and with facelib's."""
     from facelib.rendering.scene import FaceRenderer
 
     out: dict = {}
+    lambert = _lambert_shaders()
     for label, face in faces.items():
         vertices = face.deform(stream[: args.frames])
-        for tag, options in (("", {}), (", hair double-sided, all uploaded",
-                                        {"look": _double_sided_look(), "rigid_pieces": False})):
-            if tag and label == "bare":
+        for tag, options in (("", {}), (", the ceiling's shader", {}),
+                             (", hair double-sided, all uploaded",
+                              {"look": _double_sided_look(), "rigid_pieces": False})):
+            if "hair" in tag and label == "bare":
                 continue
             r = FaceRenderer(face, width=width, height=height, antialias=args.antialias,
                              **options)
+            if "shader" in tag:
+                _serve_shaders(r, lambert)
             out[f"{label}{tag}"] = _InProcess(r, vertices, stream.values[: args.frames])
         if args.shaders_before and label == "default":
             r = FaceRenderer(face, width=width, height=height, antialias=args.antialias)
@@ -174,10 +225,12 @@ def _renderers(faces: dict, stream, args, width: int, height: int) -> dict:
             out[f"{label}, shaders before"] = _InProcess(r, vertices,
                                                          stream.values[: args.frames])
         samples = 0 if out[label].mode == "off" else 4
-        try:
-            out[f"{label}: ceiling"] = _Child(label, args, samples, out[label].renderer)
-        except RuntimeError as exc:
-            print(f"no ceiling for {label}: {exc}")
+        for shading, tag in (("lambert", ""), ("face", ", face shader")):
+            try:
+                out[f"{label}: ceiling{tag}"] = _Child(label, args, samples,
+                                                       out[label].renderer, shading)
+            except RuntimeError as exc:
+                print(f"no ceiling for {label}: {exc}")
     return out
 
 
@@ -206,8 +259,11 @@ def _side_by_side(renderers: dict, rounds: int, frames: int) -> dict:
 def _report(renderers: dict, figures: dict, images: str | None) -> None:
     for name, (cpu, main) in figures.items():
         label = name.split(":")[0].split(",")[0]
-        ceiling = figures.get(f"{label}: ceiling")
-        ratio = f", {ceiling[0] / cpu:4.2f} of the ceiling" if ceiling and ":" not in name else ""
+        ratio = ""
+        for key, what in ((f"{label}: ceiling", "the ceiling"),
+                          (f"{label}: ceiling, face shader", "with face shader")):
+            if key in figures and ":" not in name:
+                ratio += f", {figures[key][0] / cpu:4.2f} of {what}"
         idle = main + (cpu - main) / 2
         print(f"  {name:38s} CPU {cpu * 1e3:6.1f} ms a frame = {1 / cpu:5.1f} frames/s; "
               f"2 idle cores ~{idle * 1e3:5.1f} ms = {1 / idle:5.1f} frames/s{ratio}")
@@ -220,9 +276,10 @@ def _report(renderers: dict, figures: dict, images: str | None) -> None:
 
 def _side_by_side_figures(faces: dict, stream, args, width: int, height: int) -> None:
     renderers = _renderers(faces, stream, args, width, height)
-    ceiling = [r.mode for r in renderers.values() if isinstance(r, _Child)]
+    ceiling = "; ".join(dict.fromkeys(r.mode for r in renderers.values()
+                                      if isinstance(r, _Child)))
     print(f"side by side ({renderers['default'].mode}; medians of {args.rounds} rounds of "
-          f"{args.frames} frames{'; ceiling on ' + ceiling[0] if ceiling else ''}):")
+          f"{args.frames} frames{'; ceilings: ' + ceiling if ceiling else ''}):")
     _report(renderers, _side_by_side(renderers, args.rounds, args.frames), args.images)
     for renderer in renderers.values():
         renderer.close()
@@ -241,6 +298,8 @@ def main() -> None:
     parser.add_argument("--shaders-before", default=None,
                         help="a folder with earlier face.vert/face.frag: also measure the "
                              "default character drawn with them, side by side")
+    parser.add_argument("--side-by-side-only", action="store_true",
+                        help="leave out the mesh-update and .fap -> MP4 figures")
     args = parser.parse_args()
     if args.platform:
         os.environ["PYOPENGL_PLATFORM"] = args.platform
@@ -257,7 +316,8 @@ def main() -> None:
     for label, face in faces.items():
         print(f"  {label}: {len(face.vertices)} vertices, {len(face.triangles)} triangles")
     _side_by_side_figures(faces, stream, args, width, height)
-    _update_figures(faces["default"], stream, args, width, height)
+    if not args.side_by_side_only:
+        _update_figures(faces["default"], stream, args, width, height)
 
 
 def _update_figures(face, stream, args, width: int, height: int) -> None:
