@@ -60,8 +60,8 @@ RINGS = np.array([
 ])
 LOOP_SHAPE = (0.7, 0.35)  # how much of the loop's own shape rings 1 and 2 keep
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
-NECK_REACH = 5  # along_neck: edges up the head's neck that set the bust's first direction
-NECK_DESCENT = (0.25, 0.6)  # along_neck: rings 0, 1 at these shares of the loop's drop to ring 2
+NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
+NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2
 SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
 NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
 GARMENT_OFFSET = 0.004  # metres outside the skin
@@ -104,13 +104,12 @@ def even_angles(loop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return theta, step + np.mean(theta - step)
 
 
-def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS, *,
-                loop_heights: bool = False) -> np.ndarray:
+def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
     """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``, the
     columns turning from the loop's vertices toward evenly spaced angles (``EVEN_COLUMNS``:
     a head's neck loop may pair vertices 0.1 mm apart with gaps of 11 mm, and columns that
     uneven rendered as stripes down the neck and garment).
-    ``loop_heights``: rings 0 and 1 lie at ``NECK_DESCENT`` of the way down from the loop
+    Rings 0 and 1 lie at ``NECK_DESCENT`` of the way down from the loop
     to ring 2, column by column (a loop that dips 4-5 cm lower at the front than at the
     back otherwise had its back drop 4 cm to ring 0 and then run level, a shelf under the
     nape, and its front rise above the loop, a fold across the throat)."""
@@ -131,10 +130,9 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS, *,
             zc = w * centre[2] + (1 - w) * ring_z
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
     out = np.array(out)
-    if loop_heights:
-        share = np.array(NECK_DESCENT)[:, None]
-        k = len(NECK_DESCENT)
-        out[1:k + 1, :, 1] = loop[:, 1] + share * (out[k + 1, :, 1] - loop[:, 1])
+    share = np.array(NECK_DESCENT)[:, None]
+    k = len(NECK_DESCENT)
+    out[1:k + 1, :, 1] = loop[:, 1] + share * (out[k + 1, :, 1] - loop[:, 1])
     return out
 
 
@@ -148,10 +146,10 @@ def tilted_plane(loop: np.ndarray) -> tuple[float, float]:
     return float(y0), float(tilt)
 
 
-def surface(controls: np.ndarray, start: np.ndarray | None = None) -> CubicSpline:
+def surface(controls: np.ndarray, start: np.ndarray) -> CubicSpline:
     """The bust surface as a spline in ring index (0 = the loop) per column; ``start``: its
-    derivative at the loop ``(S, 3)`` (metres per ring), else a natural end there."""
-    ends = "natural" if start is None else ((1, start), (2, np.zeros(controls.shape[1:])))
+    derivative at the loop ``(S, 3)`` (metres per ring)."""
+    ends = ((1, start), (2, np.zeros(controls.shape[1:])))
     return CubicSpline(np.arange(len(controls)), controls, axis=0, bc_type=ends)
 
 
@@ -266,16 +264,14 @@ def bake_ao(head_v: np.ndarray, head_t: np.ndarray, bust_v: np.ndarray,
 
 def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RINGS,
           garment_rgb: np.ndarray = GARMENT_RGB, collar_rgb: np.ndarray = COLLAR_RGB,
-          along_neck: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
+          ) -> tuple[dict[str, np.ndarray], np.ndarray]:
     """The bust's arrays and the head's (possibly unfaded) vertex colours. ``head``: the
     head's ``vertices``, ``triangles``, ``vertex_colors``, ``vertex_ao`` and ``skin`` (its
     vertex range), else the default head's; ``rings``: the cross-sections (``RINGS``);
-    the garment's and collar's sRGB colours (tools/build_characters.py varies all three);
-    ``along_neck``: the bust leaves the loop in the direction the head's neck arrives at it
-    (:func:`neck_tangents`) instead of a natural spline end (the characters: on necks whose
-    loop dips at the front the natural end rose above the loop there, a fold that rendered
-    as a dotted line across the throat; the default bust, whose rings were tuned on its own
-    neck, keeps the natural end)."""
+    the garment's and collar's sRGB colours (tools/build_characters.py varies all three).
+    The bust leaves the loop in the direction the head's neck arrives at it
+    (:func:`neck_tangents`; a natural spline end rose above a loop that dips at the front,
+    a fold that rendered as a line across the throat)."""
     given = head is not None
     if head is None:
         doc = json.loads((HEAD / "default_head.json").read_text())
@@ -289,12 +285,9 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
         head_c = unfade(head_c, head_v, skin)
     loop_ids = seam_loop(head_v, head_t, skin)
     loop = head_v[loop_ids].astype(np.float64)
-    controls = ring_points(loop, rings, loop_heights=along_neck)
-    start = None
-    if along_neck:
-        step = np.linalg.norm(controls[1] - controls[0], axis=1)
-        start = neck_tangents(head_v.astype(np.float64), head_t, loop_ids, step)
-    spline = surface(controls, start)
+    controls = ring_points(loop, rings)
+    step = np.linalg.norm(controls[1] - controls[0], axis=1)
+    spline = surface(controls, neck_tangents(head_v.astype(np.float64), head_t, loop_ids, step))
     base, n_cols = len(head_v), len(loop_ids)
     skin_v = spline(SAMPLES).reshape(-1, 3)
     rows = np.vstack([loop_ids, base + np.arange(skin_v.shape[0]).reshape(len(SAMPLES), n_cols)])

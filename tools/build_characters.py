@@ -357,7 +357,7 @@ def make_bust(head: dict, arrays: dict, skin: tuple[int, int], spec: dict,
         {**head, "triangles": triangles, "skin": np.array(skin)},
         rings=rings_for(fit[0], old=old, new=new, shoulders=spec["shoulders"]),
         garment_rgb=np.asarray(spec["garment_rgb"]),
-        collar_rgb=0.82 * np.asarray(spec["garment_rgb"]), along_neck=True)
+        collar_rgb=0.82 * np.asarray(spec["garment_rgb"]))
     small = dict(bust, vertices=bust["vertices"].astype(np.float32),
                  triangles=bust["triangles"].astype(np.uint16))
     np.savez_compressed(HEAD / f"{spec['name']}_bust.npz", **small)
