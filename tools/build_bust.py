@@ -59,7 +59,9 @@ RINGS = np.array([
     (-0.440, 0.000, 0.166, 0.113, 2.5, -0.008),
 ])
 LOOP_SHAPE = (0.7, 0.35)  # how much of the loop's own shape rings 1 and 2 keep
-RING0_MIN_DROP = 0.25  # along_neck: ring 0 at least this share of the way down to ring 1
+EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
+NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
+NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2
 SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
 NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
 GARMENT_OFFSET = 0.004  # metres outside the skin
@@ -70,6 +72,7 @@ COLLAR_RGB = np.array([0.17, 0.22, 0.31])
 NECK_FADE = {"fade_mm": 45.0, "darkest": 0.28, "point": (0.0, -0.123495, 0.058925),
              "normal": (0.0, 0.977323, 0.211753)}
 AO_DIRECTIONS = 96
+AO_SMOOTHING = 3  # rounds of neighbour averaging (bake_head_look._smooth): no column stripes
 
 
 def seam_loop(vertices: np.ndarray, triangles: np.ndarray, skin: tuple[int, int]) -> np.ndarray:
@@ -92,36 +95,44 @@ def superellipse_radius(theta: np.ndarray, a: float, b: float, n: float) -> np.n
     return (np.power(s / a, n) + np.power(c / b, n)) ** (-1.0 / n)
 
 
-def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS, *,
-                loop_heights: bool = False) -> np.ndarray:
-    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``.
-    ``loop_heights``: the first rings also keep the loop's heights where they depart from
-    a tilted plane (``LOOP_SHAPE`` of them: a throat whose loop dips in a V at the front
-    would otherwise have ring 0 above the loop there, a fold)."""
+def even_angles(loop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The loop's ``(S, 3)`` angles about the vertical axis (from the front toward +x,
+    radians, unwrapped so they rise) and ``S`` evenly spaced angles in the same order and
+    phase, where the bust's columns run from ring ``len(EVEN_COLUMNS) - 1`` on."""
+    theta = np.unwrap(np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean()))
+    step = 2 * np.pi * np.arange(len(loop)) / len(loop)
+    return theta, step + np.mean(theta - step)
+
+
+def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
+    """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``, the
+    columns turning from the loop's vertices toward evenly spaced angles (``EVEN_COLUMNS``:
+    a head's neck loop may pair vertices 0.1 mm apart with gaps of 11 mm, and columns that
+    uneven rendered as stripes down the neck and garment).
+    Rings 0 and 1 lie at ``NECK_DESCENT`` of the way down from the loop
+    to ring 2, column by column (a loop that dips 4-5 cm lower at the front than at the
+    back otherwise had its back drop 4 cm to ring 0 and then run level, a shelf under the
+    nape, and its front rise above the loop, a fold across the throat)."""
     centre = np.array([0.0, 0.0, loop[:, 2].mean()])
     rel = loop - centre
-    theta = np.arctan2(rel[:, 0], rel[:, 2])
+    theta_loop, even = even_angles(loop)
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
-    residual = np.zeros(len(loop))
-    if loop_heights:
-        height, tilt = tilted_plane(loop)
-        residual = loop[:, 1] - (height + tilt * np.cos(theta))
     out = [loop]
     for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
+        u = EVEN_COLUMNS[min(k, len(EVEN_COLUMNS) - 1)]
+        theta = (1 - u) * theta_loop + u * even
         r = superellipse_radius(theta, a, b, n)
         zc = ring_z
-        if k < len(LOOP_SHAPE):
-            w = LOOP_SHAPE[k]
-            r = w * r_loop + (1 - w) * r
-            zc = w * centre[2] + (1 - w) * ring_z
         heights = y + tilt * np.cos(theta)
         if k < len(LOOP_SHAPE):
-            heights = heights + LOOP_SHAPE[k] * residual
+            w = LOOP_SHAPE[k]
+            r = w * np.interp(theta, theta_loop, r_loop, period=2 * np.pi) + (1 - w) * r
+            zc = w * centre[2] + (1 - w) * ring_z
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
     out = np.array(out)
-    if loop_heights:  # ring 0 part of the way down to ring 1 at least, in every column
-        drop = RING0_MIN_DROP * (loop[:, 1] - out[2, :, 1])
-        out[1, :, 1] = np.minimum(out[1, :, 1], loop[:, 1] - drop)
+    share = np.array(NECK_DESCENT)[:, None]
+    k = len(NECK_DESCENT)
+    out[1:k + 1, :, 1] = loop[:, 1] + share * (out[k + 1, :, 1] - loop[:, 1])
     return out
 
 
@@ -135,29 +146,35 @@ def tilted_plane(loop: np.ndarray) -> tuple[float, float]:
     return float(y0), float(tilt)
 
 
-def surface(controls: np.ndarray, start: np.ndarray | None = None) -> CubicSpline:
+def surface(controls: np.ndarray, start: np.ndarray) -> CubicSpline:
     """The bust surface as a spline in ring index (0 = the loop) per column; ``start``: its
-    derivative at the loop ``(S, 3)`` (metres per ring), else a natural end there."""
-    ends = "natural" if start is None else ((1, start), (2, np.zeros(controls.shape[1:])))
+    derivative at the loop ``(S, 3)`` (metres per ring)."""
+    ends = ((1, start), (2, np.zeros(controls.shape[1:])))
     return CubicSpline(np.arange(len(controls)), controls, axis=0, bc_type=ends)
 
 
 def neck_tangents(vertices: np.ndarray, triangles: np.ndarray, loop_ids: np.ndarray,
                   step: np.ndarray) -> np.ndarray:
     """``(S, 3)`` the head's neck continued past its loop: at each loop vertex the direction
-    from its neighbours above (the along-loop part taken out), ``step`` ``(S,)`` long."""
-    on_loop = np.zeros(len(vertices), bool)
-    on_loop[loop_ids] = True
+    from the mean of the head's vertices up to ``NECK_REACH`` edges above it (the along-loop
+    part taken out; the last row of a throat may stand straighter than the neck above it),
+    ``step`` ``(S,)`` long."""
+    import scipy.sparse as sp
+
+    n = len(vertices)
     edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    edges = np.concatenate([edges, edges[:, ::-1]])
-    edges = edges[on_loop[edges[:, 0]] & ~on_loop[edges[:, 1]]]
-    position = np.full(len(vertices), -1)
-    position[loop_ids] = np.arange(len(loop_ids))
-    above = np.zeros((len(loop_ids), 3))
-    np.add.at(above, position[edges[:, 0]], vertices[edges[:, 1]])
-    counts = np.bincount(position[edges[:, 0]], minlength=len(loop_ids))
+    near = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    near = ((near + near.T + sp.identity(n)) > 0).astype(np.float64).tocsr()
+    reach = sp.csr_matrix((np.ones(len(loop_ids)), (np.arange(len(loop_ids)), loop_ids)),
+                          shape=(len(loop_ids), n))
+    for _ in range(NECK_REACH):
+        reach = ((reach @ near) > 0).astype(np.float64)
+    off_loop = np.ones(n)
+    off_loop[loop_ids] = 0.0
+    reach = reach.multiply(off_loop[None, :]).tocsr()
+    above = (reach @ vertices) / np.maximum(reach.sum(1), 1.0)
     loop = vertices[loop_ids]
-    down = loop - above / np.maximum(counts, 1)[:, None]
+    down = loop - np.asarray(above)
     along = np.roll(loop, -1, axis=0) - np.roll(loop, 1, axis=0)
     along /= np.linalg.norm(along, axis=1, keepdims=True)
     down -= np.einsum("ij,ij->i", down, along)[:, None] * along
@@ -238,24 +255,23 @@ def bake_ao(head_v: np.ndarray, head_t: np.ndarray, bust_v: np.ndarray,
     triangles = np.concatenate([head_t, bust_t])
     normals = vertex_normals(vertices, triangles).astype(np.float64)
     directions = bake.sphere_directions(AO_DIRECTIONS)
-    seen = bake.visibility(vertices, triangles, normals, directions)[len(head_v):]
-    weight = np.clip(normals[len(head_v):] @ directions.T, 0.0, None)
+    seen = bake.visibility(vertices, triangles, normals, directions)
+    weight = np.clip(normals @ directions.T, 0.0, None)
     ao = (seen * weight).sum(1) / np.maximum(weight.sum(1), 1e-9)
-    return np.clip(ao, 0.0, 1.0)
+    ao = bake._smooth(ao, bust_t, AO_SMOOTHING)  # over the bust (and the loop it shares)
+    return np.clip(ao[len(head_v):], 0.0, 1.0)
 
 
 def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RINGS,
           garment_rgb: np.ndarray = GARMENT_RGB, collar_rgb: np.ndarray = COLLAR_RGB,
-          along_neck: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
+          ) -> tuple[dict[str, np.ndarray], np.ndarray]:
     """The bust's arrays and the head's (possibly unfaded) vertex colours. ``head``: the
     head's ``vertices``, ``triangles``, ``vertex_colors``, ``vertex_ao`` and ``skin`` (its
     vertex range), else the default head's; ``rings``: the cross-sections (``RINGS``);
-    the garment's and collar's sRGB colours (tools/build_characters.py varies all three);
-    ``along_neck``: the bust leaves the loop in the direction the head's neck arrives at it
-    (:func:`neck_tangents`) instead of a natural spline end (the characters: on necks whose
-    loop dips at the front the natural end rose above the loop there, a fold that rendered
-    as a dotted line across the throat; the default bust, whose rings were tuned on its own
-    neck, keeps the natural end)."""
+    the garment's and collar's sRGB colours (tools/build_characters.py varies all three).
+    The bust leaves the loop in the direction the head's neck arrives at it
+    (:func:`neck_tangents`; a natural spline end rose above a loop that dips at the front,
+    a fold that rendered as a line across the throat)."""
     given = head is not None
     if head is None:
         doc = json.loads((HEAD / "default_head.json").read_text())
@@ -269,19 +285,15 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
         head_c = unfade(head_c, head_v, skin)
     loop_ids = seam_loop(head_v, head_t, skin)
     loop = head_v[loop_ids].astype(np.float64)
-    theta = np.arctan2(loop[:, 0], loop[:, 2] - loop[:, 2].mean())
-    controls = ring_points(loop, rings, loop_heights=along_neck)
-    start = None
-    if along_neck:
-        step = np.linalg.norm(controls[1] - controls[0], axis=1)
-        start = neck_tangents(head_v.astype(np.float64), head_t, loop_ids, step)
-    spline = surface(controls, start)
+    controls = ring_points(loop, rings)
+    step = np.linalg.norm(controls[1] - controls[0], axis=1)
+    spline = surface(controls, neck_tangents(head_v.astype(np.float64), head_t, loop_ids, step))
     base, n_cols = len(head_v), len(loop_ids)
     skin_v = spline(SAMPLES).reshape(-1, 3)
     rows = np.vstack([loop_ids, base + np.arange(skin_v.shape[0]).reshape(len(SAMPLES), n_cols)])
     all_v = np.concatenate([head_v, skin_v])
     skin_t = outward(all_v, quads(rows))
-    g_v, g_t, collar = garment(spline, theta, len(rings))
+    g_v, g_t, collar = garment(spline, even_angles(loop)[1], len(rings))
     start = base + len(skin_v)
     g_t = outward(np.concatenate([all_v, g_v]), g_t + start)
     vertices = np.concatenate([skin_v, g_v]).astype(np.float32)

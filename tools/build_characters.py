@@ -43,8 +43,9 @@ The skin's texture coordinates are not made here: every character shares the def
 head's skin triangles, so one file (``default_head_uv.npz``, ``tools/build_head_uv.py``)
 serves them all.
 
-Deterministic. Arrays are stored compactly (float16 bust and hair positions, uint16
-triangles) since each character ships in the wheel.
+Deterministic. Arrays are stored compactly (float16 hair positions, uint16 triangles)
+since each character ships in the wheel; the bust keeps float32 positions (float16's
+0.1-0.5 mm steps on its smooth, large surface rendered as shading stripes).
 """
 
 from __future__ import annotations
@@ -356,8 +357,8 @@ def make_bust(head: dict, arrays: dict, skin: tuple[int, int], spec: dict,
         {**head, "triangles": triangles, "skin": np.array(skin)},
         rings=rings_for(fit[0], old=old, new=new, shoulders=spec["shoulders"]),
         garment_rgb=np.asarray(spec["garment_rgb"]),
-        collar_rgb=0.82 * np.asarray(spec["garment_rgb"]), along_neck=True)
-    small = dict(bust, vertices=bust["vertices"].astype(np.float16),
+        collar_rgb=0.82 * np.asarray(spec["garment_rgb"]))
+    small = dict(bust, vertices=bust["vertices"].astype(np.float32),
                  triangles=bust["triangles"].astype(np.uint16))
     np.savez_compressed(HEAD / f"{spec['name']}_bust.npz", **small)
     return bust

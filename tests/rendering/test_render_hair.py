@@ -90,8 +90,8 @@ def test_hair_turns_with_the_head_exactly() -> None:
 @pytest.mark.parametrize("name", [None, *character_names()])
 def test_neck_shows_no_seam_at_a_30_degree_turn(name) -> None:
     """The default head and every character (whose neck loops dip lower at the front, in a
-    V: the bust's first rings keep the loop's own heights, ring 0 at least a quarter of the
-    way down to ring 1, or a light line shows along the seam)."""
+    V: the bust leaves the loop along the head's neck and its first rings descend part of
+    the way to ring 2 in every column, or a light line shows along the seam)."""
     face = load_face(name, hair=None if name else "short")  # a character in its own hair
     moved = _yawed(face, 30.0)
     with FaceRenderer(face, width=480, height=360, framing="bust") as renderer:
