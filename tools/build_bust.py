@@ -48,20 +48,23 @@ RINGS = np.array([
     (-0.132, 0.006, 0.056, 0.050, 2.0, 0.006),
     (-0.144, 0.000, 0.059, 0.052, 2.0, 0.004),
     (-0.152, -0.008, 0.066, 0.056, 2.1, 0.001),
-    (-0.158, -0.013, 0.092, 0.066, 2.2, -0.003),
-    (-0.165, -0.016, 0.125, 0.078, 2.3, -0.006),
-    (-0.176, -0.017, 0.152, 0.089, 2.4, -0.008),
-    (-0.192, -0.016, 0.172, 0.097, 2.5, -0.008),
-    (-0.214, -0.012, 0.183, 0.103, 2.5, -0.008),
-    (-0.245, -0.008, 0.186, 0.108, 2.5, -0.008),
-    (-0.290, -0.004, 0.180, 0.111, 2.5, -0.008),
-    (-0.360, 0.000, 0.172, 0.113, 2.5, -0.008),
-    (-0.440, 0.000, 0.166, 0.113, 2.5, -0.008),
+    (-0.160, -0.010, 0.090, 0.066, 2.2, -0.003),
+    (-0.170, -0.010, 0.122, 0.074, 2.3, -0.006),
+    (-0.183, -0.010, 0.152, 0.082, 2.4, -0.008),
+    (-0.199, -0.009, 0.176, 0.090, 2.6, -0.008),
+    (-0.220, -0.008, 0.192, 0.097, 2.8, -0.008),
+    (-0.250, -0.006, 0.198, 0.104, 2.8, -0.008),
+    (-0.295, -0.003, 0.194, 0.109, 2.7, -0.008),
+    (-0.360, 0.000, 0.186, 0.112, 2.6, -0.008),
+    (-0.440, 0.000, 0.180, 0.113, 2.5, -0.008),
 ])
 LOOP_SHAPE = (0.7, 0.35)  # how much of the loop's own shape rings 1 and 2 keep
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
 NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
 NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2
+# the arms' creases: from ring 7 to full at ring 9, at 62 and 118 deg from the front, 10 deg
+# wide, taking in 4 % of the radius
+ARMS = (6, 8, 62.0, 118.0, 12.0, 0.08)
 SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
 NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
 GARMENT_OFFSET = 0.004  # metres outside the skin
@@ -121,7 +124,7 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
     for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
         u = EVEN_COLUMNS[min(k, len(EVEN_COLUMNS) - 1)]
         theta = (1 - u) * theta_loop + u * even
-        r = superellipse_radius(theta, a, b, n)
+        r = superellipse_radius(theta, a, b, n) * (1 - arm_creases(theta, k))
         zc = ring_z
         heights = y + tilt * np.cos(theta)
         if k < len(LOOP_SHAPE):
@@ -134,6 +137,16 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
     k = len(NECK_DESCENT)
     out[1:k + 1, :, 1] = loop[:, 1] + share * (out[k + 1, :, 1] - loop[:, 1])
     return out
+
+
+def arm_creases(theta: np.ndarray, ring: int) -> np.ndarray:
+    """The share of a ring's radius taken in where the arms meet the chest and the back
+    (``ARMS``), at angles ``theta`` (radians from the front), ``ring``: its index."""
+    start, full, front, back, width, depth = ARMS
+    ramp = np.clip((ring - start) / (full - start), 0.0, 1.0)
+    side = np.degrees(np.abs(np.angle(np.exp(1j * theta))))
+    crease = np.exp(-(((side - front) / width) ** 2)) + np.exp(-(((side - back) / width) ** 2))
+    return depth * ramp * crease
 
 
 def tilted_plane(loop: np.ndarray) -> tuple[float, float]:
