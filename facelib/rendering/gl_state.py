@@ -1,28 +1,21 @@
-"""Cheaper OpenGL state changes for pyrender, with the same pixels.
+"""Cheaper uniform setting for pyrender's shader programs, with the same pixels.
 
 pyrender sets every uniform of every primitive on every frame, each through
-``glGetUniformLocation`` (and a Python exception for each name the shader does not use), and
-draws opaque materials with blending on and the blend function ``ONE, ZERO``: llvmpipe then
-reads the framebuffer back for each fragment to blend with weight zero. Two changes, both
-exact:
-
-- :func:`install_uniform_cache` gives one shader program a cache of uniform locations and
-  of the values last set: a uniform keeps its value in its program, so setting the same
-  value again is skipped;
-- :func:`install_opaque_blending` makes pyrender's ``glBlendFunc(GL_ONE, GL_ZERO)`` turn
-  blending off, which writes the same colour (``source * 1 + destination * 0``).
+``glGetUniformLocation`` (and a Python exception for each name the shader does not use).
+:func:`install_uniform_cache` gives one shader program a cache of uniform locations and of
+the values last set: a uniform keeps its value in its program, so setting the same value
+again is skipped (exact).
 
 Measured in ``benchmarks/render_speed.py`` (docs/rendering.md, "Speed").
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
 
 import numpy as np
 
-__all__ = ["install_opaque_blending", "install_uniform_cache"]
+__all__ = ["install_uniform_cache"]
 
 _UNSET = object()
 
@@ -85,23 +78,3 @@ def _write(program: Any, loc: int, value: Any, unsigned: bool) -> None:
         GL.glUniform1ui(loc, int(value))
     else:
         GL.glUniform1i(loc, int(value))
-
-
-def install_opaque_blending(pr: Any) -> None:
-    """Make pyrender (the module ``pr``) draw with blending off wherever it asks for the
-    blend function ``ONE, ZERO`` (its opaque materials); idempotent. Process-wide, and exact
-    for every pyrender renderer: blending with those weights writes the source colour."""
-    from OpenGL import GL
-
-    module: Any = importlib.import_module(f"{pr.__name__}.renderer")
-    blend_func = module.glBlendFunc
-    if getattr(blend_func, "facelib_opaque", False):
-        return
-
-    def glBlendFunc(sfactor: int, dfactor: int) -> None:  # noqa: N802  # pyrender's name
-        blend_func(sfactor, dfactor)
-        if sfactor == GL.GL_ONE and dfactor == GL.GL_ZERO:
-            GL.glDisable(GL.GL_BLEND)
-
-    glBlendFunc.facelib_opaque = True  # type: ignore[attr-defined]
-    module.glBlendFunc = glBlendFunc

@@ -36,7 +36,7 @@ import numpy as np
 from facelib import data
 from facelib.engine.colours import occlusion_factor, srgb_to_linear
 from facelib.errors import FaceModelError, ParameterError, RenderError
-from facelib.rendering.gl_state import install_opaque_blending, install_uniform_cache
+from facelib.rendering.gl_state import install_uniform_cache
 from facelib.rendering.normals import normal_operator, vertex_normals
 from facelib.rendering.platform import INSTALL_HINT, import_pyrender
 from facelib.rendering.protocols import Deformable
@@ -394,10 +394,8 @@ def install_program_cache(pr: Any, renderer: Any, look: Look, *,
     each call, so every frame missed the cache, recompiled every shader and leaked the old
     programs (about 40% of the frame time at 640x480). A renderer has exactly one context.
     Its programs set their uniforms through
-    :func:`facelib.rendering.gl_state.install_uniform_cache`, and pyrender draws opaque
-    materials with blending off (:func:`facelib.rendering.gl_state.install_opaque_blending`).
+    :func:`facelib.rendering.gl_state.install_uniform_cache`.
     """
-    install_opaque_blending(pr)
     base = pr.shader_program.ShaderProgramCache
     old = getattr(renderer, "_program_cache", None)
     if not isinstance(old, base):

@@ -85,11 +85,7 @@ def test_the_fast_paths_keep_the_picture() -> None:
 
 
 @pytest.mark.render
-def test_cached_uniforms_and_opaque_blending_keep_the_picture() -> None:
-    import importlib
-
-    from OpenGL import GL
-
+def test_cached_uniforms_keep_the_picture() -> None:
     from facelib.engine import load_face
     from facelib.rendering.scene import FaceRenderer
 
@@ -98,18 +94,11 @@ def test_cached_uniforms_and_opaque_blending_keep_the_picture() -> None:
     values[1, 2] = 300  # jaw open
     values[2, 48] = 20000  # head yaw
     poses = [face.deform_frame(v) for v in values]
-    module = importlib.import_module("pyrender.renderer")
     with FaceRenderer(face, width=W, height=H, framing="head") as renderer:
         fast = [renderer.frame(v, faps=f) for v, f in zip(poses, values, strict=True)]
-        assert not GL.glIsEnabled(GL.GL_BLEND)  # opaque parts drawn without blending
-        # pyrender's own uniform setting and blending, on the same programs
+        # pyrender's own uniform setting, on the same programs
         for program in renderer._renderer._renderer._program_cache._by_source.values():
             del program.set_uniform
-        patched, module.glBlendFunc = module.glBlendFunc, GL.glBlendFunc
-        try:
-            plain = [renderer.frame(v, faps=f) for v, f in zip(poses, values, strict=True)]
-            assert GL.glIsEnabled(GL.GL_BLEND)
-        finally:
-            module.glBlendFunc = patched
+        plain = [renderer.frame(v, faps=f) for v, f in zip(poses, values, strict=True)]
     for a, b in zip(fast, plain, strict=True):
         assert np.array_equal(a, b)
