@@ -58,7 +58,7 @@ RINGS = np.array([
     (-0.360, 0.000, 0.186, 0.112, 2.6, -0.008),
     (-0.440, 0.000, 0.180, 0.113, 2.5, -0.008),
 ])
-LOOP_SHAPE = (0.7, 0.35)  # how much of the loop's own shape rings 1 and 2 keep
+LOOP_SHAPE = (0.8, 0.5, 0.25)  # how much of the loop's own shape rings 0, 1 and 2 keep
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
 NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
 NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2

@@ -38,11 +38,13 @@ def smile() -> np.ndarray:
 
 def row(name: str, *, plain: bool) -> list[np.ndarray]:
     face = load_face(name)
-    poses = (face.vertices, face.deform_frame(smile()))
+    values = smile()
+    poses = ((face.vertices, np.zeros_like(values)), (face.deform_frame(values), values))
     images = []
     for framing in FRAMINGS:
         with FaceRenderer(face, width=W, height=H, framing=framing) as renderer:
-            images += [np.asarray(renderer.frame(v)) for v in poses]
+            # the FAPs too, so the smile's wrinkles show as in a rendered video
+            images += [np.asarray(renderer.frame(v, faps=f)) for v, f in poses]
     if not plain:
         images[0] = label(images[0], name)
     return images
