@@ -62,8 +62,8 @@ LOOP_SHAPE = (0.8, 0.5, 0.25)  # how much of the loop's own shape rings 0, 1 and
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
 NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
 NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2
-# the arms' creases: from ring 7 to full at ring 9, at 62 and 118 deg from the front, 10 deg
-# wide, taking in 4 % of the radius
+# the arms' creases: from ring 6 to full at ring 8, at 62 and 118 deg from the front, 12 deg
+# wide, taking in 8 % of the radius
 ARMS = (6, 8, 62.0, 118.0, 12.0, 0.08)
 SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
 NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
