@@ -89,6 +89,10 @@ def test_a_rendered_track_is_measured_from_its_real_neutral():
                str(w.message) for w in caught)
     true = measure_faps(points, fps=FPS, neutral=(15, 25)).stream.values
     first = measure_faps(points, fps=FPS, neutral=0).stream.values
+    # measured from the held frame, every frame is off by most of what the tracker reads of
+    # the hold (its reading of jaw 200 and corners 210 varies from run to run, 100-130)
     for fap in (3, 12, 13):
-        assert np.abs(auto[:, fap - 1] - true[:, fap - 1]).max() < 20
-        assert np.abs(first[:, fap - 1] - true[:, fap - 1]).max() > 100
+        auto_error = np.abs(auto[:, fap - 1] - true[:, fap - 1]).max()
+        first_error = np.abs(first[:, fap - 1] - true[:, fap - 1]).max()
+        assert auto_error < 20
+        assert first_error > max(0.75 * true[:15, fap - 1].mean(), 4 * auto_error)
