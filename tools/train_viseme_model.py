@@ -25,11 +25,13 @@ low- and high-pass) and 8-bit mu-law coding. Features are those of
 spectra of frames ``t + OFFSETS``; its weights are stored for numpy inference.
 
     OMP_NUM_THREADS=1 nice -n 10 PYTHONPATH=. .venv/bin/python tools/train_viseme_model.py \\
-        [--utterances N] [--epochs E] [--work DIR] [--out PATH] [--seed S] [--cmn 0|1]
+        [--utterances N] [--epochs E] [--flite-share F] [--work DIR] [--out PATH] [--seed S]
+        [--cmn 0|1]
 
 Time: with 6000 utterances (about 10 hours of audio) the data take 5-9 minutes and each
-epoch 6-12 minutes on one thread of this shared 2-core machine (load average 8-15); the
-shipped checkpoint (epoch 2) took 22 minutes in all.
+epoch 2-12 minutes on one thread of this shared 2-core machine (the more so the higher its
+load). The shipped model is the last checkpoint of ``--utterances 9000 --epochs 6
+--flite-share 0.35`` (14.7 hours of audio): data 8 minutes, 25 minutes in all.
 
 Stages are cached in ``--work`` (synthesized data per batch); rerunning with the same
 arguments gives the same model bit for bit on the same machine and library versions. After
