@@ -263,21 +263,28 @@ def ponytail(spec: dict, first_card: int, rng: np.random.Generator) -> dict:
     path = np.asarray(spec["path"], float) / 1000
     spine = CubicSpline(np.linspace(0, 1, len(path)), path, axis=0)
     k, n = spec["segments"] + 1, spec["cards"]
-    s = np.linspace(0, 1, k)
+    r0, r1, r2 = np.asarray(spec["radius_mm"]) / 1000
+    # each lock its own length, and the locks loosen toward the tips (fanning out and
+    # winding a little about the tail): one radius for all read as a stiff tube
+    reach = rng.uniform(0.72, 1.0, n)
+    fan = rng.uniform(0.0, 0.9, n)
+    wind, phase = rng.uniform(0.5, 1.5, n), rng.uniform(0, 2 * np.pi, n)
+    s = reach[:, None] * np.linspace(0, 1, k)[None]  # (n, k) along the spine
     centre = spine(s)
     tangent = spine(s, 1)
-    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    tangent /= np.linalg.norm(tangent, axis=2, keepdims=True)
     e1 = np.cross(tangent, [1.0, 0, 0])
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e1 /= np.linalg.norm(e1, axis=2, keepdims=True)
     e2 = np.cross(tangent, e1)
-    r0, r1, r2 = np.asarray(spec["radius_mm"]) / 1000
-    radius = np.interp(s, [0, 0.35, 1], [r0, r1, r2])
-    angle = np.linspace(0, 2 * np.pi, n, endpoint=False) + rng.normal(0, 0.15, n)
+    radius = np.interp(s, [0, 0.35, 1], [r0, r1, r2]) * (1 + fan[:, None] * s ** 2)
+    angle = (np.linspace(0, 2 * np.pi, n, endpoint=False) + rng.normal(0, 0.15, n))[:, None]
+    angle = angle + 0.3 * s * np.sin(2 * np.pi * wind[:, None] * s + phase[:, None])
     scale = rng.uniform(0.55, 1.05, n)
-    around = (np.cos(angle)[:, None, None] * e1[None] + np.sin(angle)[:, None, None] * e2[None])
-    lines = centre[None] + around * (radius[None, :, None] * scale[:, None, None])
-    width = np.full(n, spec["width_mm"] / 1000)
+    around = np.cos(angle)[..., None] * e1 + np.sin(angle)[..., None] * e2
+    lines = centre + around * (radius * scale[:, None])[..., None]
+    width = spec["width_mm"] / 1000 * rng.uniform(0.8, 1.2, n)
     v, t, uv = ribbons(lines, around, width, spec["taper"], first_card)
+    tangent, e1, e2 = tangent[0], e1[0], e2[0]  # the band sits where the tail starts
     ring_a = np.linspace(0, 2 * np.pi, 16, endpoint=False)
     band_v = []
     for dy, rr in ((0.0, r0 * 1.15), (0.006, r0 * 1.15)):
