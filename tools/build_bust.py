@@ -78,6 +78,7 @@ COLLAR_RGB = np.array([0.17, 0.22, 0.31])
 # what skin_tone.json baked before the bust: the fade and the neck plane it was measured from
 NECK_FADE = {"fade_mm": 45.0, "darkest": 0.28, "point": (0.0, -0.123495, 0.058925),
              "normal": (0.0, 0.977323, 0.211753)}
+COLOUR_SPAN = 4  # loop vertices either side whose colours a bust column continues
 AO_DIRECTIONS = 96
 AO_SMOOTHING = 3  # rounds of neighbour averaging (bake_head_look._smooth): no column stripes
 
@@ -220,6 +221,13 @@ def neck_tangents(vertices: np.ndarray, triangles: np.ndarray, loop_ids: np.ndar
     return down * step[:, None]
 
 
+def along_loop_mean(values: np.ndarray, span: int) -> np.ndarray:
+    """``(S, C)`` each loop vertex's ``values`` averaged with the ``span`` vertices on
+    either side (the loop closes on itself)."""
+    window = np.arange(-span, span + 1)
+    return values[(np.arange(len(values))[:, None] + window) % len(values)].mean(axis=1)
+
+
 def quads(rows: np.ndarray) -> np.ndarray:
     """Triangles ``(2 (K-1) S, 3)`` joining consecutive rows of a closed grid of ids ``(K, S)``."""
     a, b = rows[:-1], np.roll(rows[:-1], -1, axis=1)
@@ -337,8 +345,9 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
     g_t = outward(np.concatenate([all_v, g_v]), g_t + start)
     vertices = np.concatenate([skin_v, g_v]).astype(np.float32)
     triangles = np.concatenate([skin_t, g_t]).astype(np.int32)
-    # colours: each column continues its loop vertex's skin colour, toward the loop's mean
-    loop_rgb = head_c[loop_ids].astype(float)
+    # colours: each column continues the skin colour of the loop around its vertex (one
+    # vertex's own varies by 2-3 %: carried down, it striped the neck), toward the loop's mean
+    loop_rgb = along_loop_mean(head_c[loop_ids].astype(float), COLOUR_SPAN)
     fall = np.clip(SAMPLES / 4.0, 0, 1)[:, None, None]
     skin_rgb = (1 - fall) * loop_rgb[None] + fall * loop_rgb.mean(0)
     g_rgb = np.where(collar[:, None], collar_rgb, garment_rgb) * 255
