@@ -213,11 +213,9 @@ def occlusion(face) -> np.ndarray:
         for name, value in values.items():
             frame[fap(name).index] = value
         vertices = np.asarray(face.deform_frame(frame), np.float64)
-        normals = np.zeros_like(vertices)
-        for part in face.parts.values():  # each part's own smooth normals, as rendered
-            ids = part.vertex_ids
-            local = np.searchsorted(ids, part.triangles)
-            normals[ids] = vertex_normals(vertices[ids], local, unused=(0.0, 0.0, 1.0))
+        # smooth normals as rendered: each part its own, except where parts share vertices
+        # (the bust's first row is the head's neck loop: both sides' triangles count there)
+        normals = vertex_normals(vertices, face.triangles, unused=(0.0, 0.0, 1.0))
         seen = visibility(vertices, face.triangles, normals, directions)
         weight = np.clip(normals @ directions.T, 0.0, None)
         open_sky = (seen * weight).sum(1) / np.maximum(weight.sum(1), 1e-9)

@@ -62,6 +62,10 @@ LOOP_SHAPE = (0.8, 0.5, 0.25)  # how much of the loop's own shape rings 0, 1 and
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
 NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
 NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2
+# rings 0, 1 carry the neck on at its own slope (outward per metre down), at most this at
+# the back (a nape runs on into the upper back) and none at the sides and front (a neck
+# that flares at its loop would go on into a bell), at least -0.3 (a throat that leans in)
+NECK_SLOPE = (-0.3, 0.45)
 # the arms' creases: from ring 6 to full at ring 8, at 62 and 118 deg from the front, 12 deg
 # wide, taking in 8 % of the radius
 ARMS = (6, 8, 62.0, 118.0, 12.0, 0.08)
@@ -74,6 +78,7 @@ COLLAR_RGB = np.array([0.17, 0.22, 0.31])
 # what skin_tone.json baked before the bust: the fade and the neck plane it was measured from
 NECK_FADE = {"fade_mm": 45.0, "darkest": 0.28, "point": (0.0, -0.123495, 0.058925),
              "normal": (0.0, 0.977323, 0.211753)}
+COLOUR_SPAN = 4  # loop vertices either side whose colours a bust column continues
 AO_DIRECTIONS = 96
 AO_SMOOTHING = 3  # rounds of neighbour averaging (bake_head_look._smooth): no column stripes
 
@@ -107,7 +112,7 @@ def even_angles(loop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return theta, step + np.mean(theta - step)
 
 
-def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
+def ring_points(loop: np.ndarray, slope: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
     """``(R + 1, S, 3)`` control points: the loop, then every ring of ``rings``, the
     columns turning from the loop's vertices toward evenly spaced angles (``EVEN_COLUMNS``:
     a head's neck loop may pair vertices 0.1 mm apart with gaps of 11 mm, and columns that
@@ -115,11 +120,15 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
     Rings 0 and 1 lie at ``NECK_DESCENT`` of the way down from the loop
     to ring 2, column by column (a loop that dips 4-5 cm lower at the front than at the
     back otherwise had its back drop 4 cm to ring 0 and then run level, a shelf under the
-    nape, and its front rise above the loop, a fold across the throat)."""
+    nape, and its front rise above the loop, a fold across the throat), and carry the neck
+    on at ``slope`` ``(S,)`` (:func:`neck_slopes`) instead of drawing it toward their
+    ellipses (a neck that flares at its loop and a bust that tucked back in rendered as a
+    lump below the jaw and a ledge across the nape); ring 2 is nowhere narrower than the loop."""
     centre = np.array([0.0, 0.0, loop[:, 2].mean()])
     rel = loop - centre
     theta_loop, even = even_angles(loop)
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
+    descent = len(NECK_DESCENT)
     out = [loop]
     for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
         u = EVEN_COLUMNS[min(k, len(EVEN_COLUMNS) - 1)]
@@ -129,14 +138,31 @@ def ring_points(loop: np.ndarray, rings: np.ndarray = RINGS) -> np.ndarray:
         heights = y + tilt * np.cos(theta)
         if k < len(LOOP_SHAPE):
             w = LOOP_SHAPE[k]
-            r = w * np.interp(theta, theta_loop, r_loop, period=2 * np.pi) + (1 - w) * r
+            own = np.interp(theta, theta_loop, r_loop, period=2 * np.pi)
+            r = np.maximum(w * own + (1 - w) * r, own)
             zc = w * centre[2] + (1 - w) * ring_z
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
     out = np.array(out)
     share = np.array(NECK_DESCENT)[:, None]
-    k = len(NECK_DESCENT)
-    out[1:k + 1, :, 1] = loop[:, 1] + share * (out[k + 1, :, 1] - loop[:, 1])
+    drop = share * (out[descent + 1, :, 1] - loop[:, 1])
+    out[1:descent + 1, :, 1] = loop[:, 1] + drop
+    for k in range(descent):
+        theta = (1 - EVEN_COLUMNS[k]) * theta_loop + EVEN_COLUMNS[k] * even
+        own = np.interp(theta, theta_loop, r_loop, period=2 * np.pi) - slope * drop[k]
+        out[k + 1, :, 0] = own * np.sin(theta)
+        out[k + 1, :, 2] = centre[2] + own * np.cos(theta)
     return out
+
+
+def neck_slopes(loop: np.ndarray, arrival: np.ndarray) -> np.ndarray:
+    """``(S,)`` how far the neck moves out from the vertical axis per metre it descends,
+    at each vertex of the ``loop`` ``(S, 3)`` along the unit directions ``arrival``
+    ``(S, 3)`` (:func:`neck_tangents`), held to ``NECK_SLOPE`` (its top end at the back only)."""
+    outwards = loop[:, [0, 2]] - [0.0, loop[:, 2].mean()]
+    outwards /= np.linalg.norm(outwards, axis=1, keepdims=True)
+    slope = np.einsum("ij,ij->i", arrival[:, [0, 2]], outwards) / -arrival[:, 1]
+    back = np.clip(-outwards[:, 1], 0.0, 1.0)
+    return np.clip(slope, NECK_SLOPE[0], NECK_SLOPE[1] * back)
 
 
 def arm_creases(theta: np.ndarray, ring: int) -> np.ndarray:
@@ -193,6 +219,13 @@ def neck_tangents(vertices: np.ndarray, triangles: np.ndarray, loop_ids: np.ndar
     down -= np.einsum("ij,ij->i", down, along)[:, None] * along
     down /= np.linalg.norm(down, axis=1, keepdims=True)
     return down * step[:, None]
+
+
+def along_loop_mean(values: np.ndarray, span: int) -> np.ndarray:
+    """``(S, C)`` each loop vertex's ``values`` averaged with the ``span`` vertices on
+    either side (the loop closes on itself)."""
+    window = np.arange(-span, span + 1)
+    return values[(np.arange(len(values))[:, None] + window) % len(values)].mean(axis=1)
 
 
 def quads(rows: np.ndarray) -> np.ndarray:
@@ -298,9 +331,10 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
         head_c = unfade(head_c, head_v, skin)
     loop_ids = seam_loop(head_v, head_t, skin)
     loop = head_v[loop_ids].astype(np.float64)
-    controls = ring_points(loop, rings)
+    arrival = neck_tangents(head_v.astype(np.float64), head_t, loop_ids, np.ones(len(loop)))
+    controls = ring_points(loop, neck_slopes(loop, arrival), rings)
     step = np.linalg.norm(controls[1] - controls[0], axis=1)
-    spline = surface(controls, neck_tangents(head_v.astype(np.float64), head_t, loop_ids, step))
+    spline = surface(controls, arrival * step[:, None])
     base, n_cols = len(head_v), len(loop_ids)
     skin_v = spline(SAMPLES).reshape(-1, 3)
     rows = np.vstack([loop_ids, base + np.arange(skin_v.shape[0]).reshape(len(SAMPLES), n_cols)])
@@ -311,8 +345,9 @@ def build(head: dict[str, np.ndarray] | None = None, *, rings: np.ndarray = RING
     g_t = outward(np.concatenate([all_v, g_v]), g_t + start)
     vertices = np.concatenate([skin_v, g_v]).astype(np.float32)
     triangles = np.concatenate([skin_t, g_t]).astype(np.int32)
-    # colours: each column continues its loop vertex's skin colour, toward the loop's mean
-    loop_rgb = head_c[loop_ids].astype(float)
+    # colours: each column continues the skin colour of the loop around its vertex (one
+    # vertex's own varies by 2-3 %: carried down, it striped the neck), toward the loop's mean
+    loop_rgb = along_loop_mean(head_c[loop_ids].astype(float), COLOUR_SPAN)
     fall = np.clip(SAMPLES / 4.0, 0, 1)[:, None, None]
     skin_rgb = (1 - fall) * loop_rgb[None] + fall * loop_rgb.mean(0)
     g_rgb = np.where(collar[:, None], collar_rgb, garment_rgb) * 255

@@ -39,6 +39,8 @@ ROOT = Path(__file__).resolve().parent.parent
 HEAD = ROOT / "facelib" / "data" / "head"
 OUT = HEAD / "default_hair.npz"
 DOWN = np.array([0.0, -1.0, 0.0])
+# z (m): a parted style's hair is not parted behind the first, fully parted in front of the second
+PART_BACK = (-0.035, 0.015)
 
 
 def vertex_normals(v: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -132,6 +134,23 @@ def above_hairline(p: np.ndarray, head: dict, spec: dict) -> np.ndarray:
     return above
 
 
+def largest_patch(pos: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """The triangles ``(F, 3)`` (into ``pos`` ``(V, 3)``, whose vertices repeat where
+    triangles meet) of the largest edge-connected patch: the scalp. The skin also lines the
+    mouth, and the back of that lining lies above the nape's hairline seen from the head's
+    axis: hair grown there came out through the neck as a stray lock across the throat."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    _, same = np.unique(np.round(pos * 1e7).astype(np.int64), axis=0, return_inverse=True)
+    corner = same.ravel()[tris]
+    edges = np.concatenate([corner[:, [0, 1]], corner[:, [1, 2]]])
+    n = int(corner.max()) + 1 if len(corner) else 0
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    label = connected_components(graph, directed=False)[1][corner[:, 0]]
+    return tris[label == np.bincount(label).argmax()]
+
+
 def cap(head: dict, spec: dict, colour: np.ndarray) -> dict:
     """The scalp cap: skin triangles near and above the hairline, subdivided, the pieces
     above it kept and lifted off the skin."""
@@ -139,7 +158,7 @@ def cap(head: dict, spec: dict, colour: np.ndarray) -> dict:
     near = (above_hairline(head["v"], head, spec)[tris] > -0.02).any(1)
     pos, nrm, sub = subdivide(head["v"], head["normals"], tris[near], 3)
     above = above_hairline(pos, head, spec)
-    keep = sub[(above[sub] > 0).all(1)]
+    keep = largest_patch(pos, sub[(above[sub] > 0).all(1)])
     ids = np.unique(keep)
     soft = np.clip(above[ids] / (spec["soft_mm"] / 1000), 0, 1)
     soft = soft * soft * (3 - 2 * soft)
@@ -174,7 +193,10 @@ def flow(style: dict, p: np.ndarray) -> np.ndarray:
     elif kind == "part":
         part = style["part_x_mm"] / 1000
         away = np.where(p[:, 0] >= part, 1.0, -1.0)[:, None] * np.array([1.0, 0, 0])
-        d = 0.8 * away + 0.5 * DOWN + 0.45 * np.array([0, 0, -1.0])
+        # the parting runs from the hairline back to the crown; behind it the hair falls
+        # straight down the back (parted to the nape, it opened a gap like a tent)
+        parted = np.clip((p[:, 2] - PART_BACK[0]) / (PART_BACK[1] - PART_BACK[0]), 0, 1)
+        d = 0.8 * parted[:, None] * away + 0.5 * DOWN + 0.45 * np.array([0, 0, -1.0])
     else:
         d = np.asarray(style["tie_mm"]) / 1000 - p
     return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9)
@@ -241,21 +263,28 @@ def ponytail(spec: dict, first_card: int, rng: np.random.Generator) -> dict:
     path = np.asarray(spec["path"], float) / 1000
     spine = CubicSpline(np.linspace(0, 1, len(path)), path, axis=0)
     k, n = spec["segments"] + 1, spec["cards"]
-    s = np.linspace(0, 1, k)
+    r0, r1, r2 = np.asarray(spec["radius_mm"]) / 1000
+    # each lock its own length, and the locks loosen toward the tips (fanning out and
+    # winding a little about the tail): one radius for all read as a stiff tube
+    reach = rng.uniform(0.72, 1.0, n)
+    fan = rng.uniform(0.0, 0.9, n)
+    wind, phase = rng.uniform(0.5, 1.5, n), rng.uniform(0, 2 * np.pi, n)
+    s = reach[:, None] * np.linspace(0, 1, k)[None]  # (n, k) along the spine
     centre = spine(s)
     tangent = spine(s, 1)
-    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    tangent /= np.linalg.norm(tangent, axis=2, keepdims=True)
     e1 = np.cross(tangent, [1.0, 0, 0])
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e1 /= np.linalg.norm(e1, axis=2, keepdims=True)
     e2 = np.cross(tangent, e1)
-    r0, r1, r2 = np.asarray(spec["radius_mm"]) / 1000
-    radius = np.interp(s, [0, 0.35, 1], [r0, r1, r2])
-    angle = np.linspace(0, 2 * np.pi, n, endpoint=False) + rng.normal(0, 0.15, n)
+    radius = np.interp(s, [0, 0.35, 1], [r0, r1, r2]) * (1 + fan[:, None] * s ** 2)
+    angle = (np.linspace(0, 2 * np.pi, n, endpoint=False) + rng.normal(0, 0.15, n))[:, None]
+    angle = angle + 0.3 * s * np.sin(2 * np.pi * wind[:, None] * s + phase[:, None])
     scale = rng.uniform(0.55, 1.05, n)
-    around = (np.cos(angle)[:, None, None] * e1[None] + np.sin(angle)[:, None, None] * e2[None])
-    lines = centre[None] + around * (radius[None, :, None] * scale[:, None, None])
-    width = np.full(n, spec["width_mm"] / 1000)
+    around = np.cos(angle)[..., None] * e1 + np.sin(angle)[..., None] * e2
+    lines = centre + around * (radius * scale[:, None])[..., None]
+    width = spec["width_mm"] / 1000 * rng.uniform(0.8, 1.2, n)
     v, t, uv = ribbons(lines, around, width, spec["taper"], first_card)
+    tangent, e1, e2 = tangent[0], e1[0], e2[0]  # the band sits where the tail starts
     ring_a = np.linspace(0, 2 * np.pi, 16, endpoint=False)
     band_v = []
     for dy, rr in ((0.0, r0 * 1.15), (0.006, r0 * 1.15)):

@@ -31,9 +31,9 @@ overjet). The script:
    and every vertex id that the head's data holds moves with them (feature points, regions,
    riders, the MediaPipe embedding ``facelib/data/tracking/default_head_mediapipe.json``; a
    landmark that sat on an old tooth moves to the nearest new vertex of that row; after the
-   bake the embedding is found afresh with ``embed_landmarks``, as its test asks). Feature
-   points 9.10 and 9.11 (the biting edges of the upper and lower teeth, middle) go on the
-   left central incisors' edges;
+   bake the embedding is found afresh by ``tools/build_tracking_embedding.py``, as its test
+   asks). Feature points 9.10 and 9.11 (the biting edges of the upper and lower teeth,
+   middle) go on the left central incisors' edges;
 7. re-bakes the head's ambient occlusion (``tools/bake_head_look.py``).
 
 Deterministic: fixed tables and seed; running it again gives the same head (up to the AO
@@ -629,19 +629,12 @@ def main(*, write: bool = True, tracking: bool = True, bake: bool = True) -> Non
 
         bake_head_look.main()
     if tracking and bake:
-        refresh_embedding()
+        # the MediaPipe embedding found afresh on the new head (needs the ``render`` and
+        # ``track`` extras): the open mouth that it is found on looks different now, so
+        # MediaPipe's fit moves, and the remapped ids alone no longer match a fresh run
+        import build_tracking_embedding
 
-
-def refresh_embedding() -> None:
-    """Regenerate the MediaPipe embedding on the new head (needs the ``render`` and ``track``
-    extras): the open mouth that it is found on looks different now, so MediaPipe's fit
-    moves, and the remapped ids alone no longer match a fresh run."""
-    from facelib.engine import default_face
-    from facelib.tracking.embedding import embed_landmarks
-
-    emb = json.loads(EMBEDDING.read_text())
-    emb["vertices"] = [int(i) for i in embed_landmarks(default_face())]
-    EMBEDDING.write_text(json.dumps(emb) + "\n")
+        build_tracking_embedding.main()
 
 
 if __name__ == "__main__":

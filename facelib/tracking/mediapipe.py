@@ -18,7 +18,7 @@ import sys
 import tempfile
 import threading
 from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
@@ -128,7 +128,8 @@ class FaceMeshTracker:
     Parameters
     ----------
     video: True treats successive images as video frames (faces are tracked between frames,
-        faster and steadier); False detects afresh in every image.
+        faster and steadier; a frame where a face is found afresh is read twice, the second
+        time as tracked from the first); False detects afresh in every image.
     max_faces: faces to look for (one is returned: the module docstring says which), >= 1.
     min_detection_confidence, min_tracking_confidence: MediaPipe's thresholds in [0, 1].
     follow: in a video, the ``(4,)`` box (left, top, right, bottom) pixels of a face to
@@ -156,6 +157,7 @@ class FaceMeshTracker:
                 raise
         self._seen_face = False
         self._video = video
+        self._held = False  # a face was found in the frame before (video)
         self._previous: np.ndarray | None = (  # the box of the face kept last
             None if follow is None else np.array(follow, np.float64))
 
@@ -172,6 +174,15 @@ class FaceMeshTracker:
             with _native_stderr_logged():
                 result = self._mesh.process(rgb)
         faces = result.multi_face_landmarks or []
+        if faces and self._video and not self._held:
+            # a face found afresh is read in the face detector's box and tilt, which sit it
+            # less well (a face lying on its side: chin to nose tip 5 % longer than in the
+            # frames after, and a neutral taken over the first frames carried it); the frame
+            # is read again as the next would be, in the box of the landmarks just found
+            with _native_stderr_logged() if not self._seen_face else nullcontext():
+                result = self._mesh.process(rgb)
+            faces = result.multi_face_landmarks or faces
+        self._held = bool(faces)
         if not faces:
             return None
         self._seen_face = True
