@@ -55,8 +55,8 @@ RINGS = np.array([
     (-0.220, -0.008, 0.192, 0.097, 2.8, -0.008),
     (-0.250, -0.006, 0.198, 0.104, 2.8, -0.008),
     (-0.295, -0.003, 0.194, 0.109, 2.7, -0.008),
-    (-0.360, 0.000, 0.186, 0.112, 2.6, -0.008),
-    (-0.440, 0.000, 0.180, 0.113, 2.5, -0.008),
+    (-0.460, 0.000, 0.186, 0.112, 2.6, -0.008),  # the last two low enough that the bust
+    (-0.620, 0.000, 0.180, 0.113, 2.5, -0.008),  # framing of long hair shows no cut edge
 ])
 LOOP_SHAPE = (0.8, 0.5, 0.25)  # how much of the loop's own shape rings 0, 1 and 2 keep
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on

@@ -78,10 +78,10 @@ LEVELS = {"min": 0.0, "average": 0.5, "max": 1.0}
 RACES = ("african", "asian", "caucasian")
 MOUTH_TOLERANCE = 30  # uint8 distance from the cavity's colour within which it is kept
 IRIS_POLAR = (0.175, 0.48)  # radians from the eye's pole: the iris rings of the eye sphere
-# heights (m) the last two bust rings reach at least (the default's: -0.36, -0.44): the
-# bust framing frames the hair too, and long hair reaches the shoulders, so the frame goes
-# lower than the default bust's cut edge
-BUST_END = (-0.46, -0.62)
+# heights (m) the last two bust rings reach at least, the default's (a smaller character's
+# scaled rings would end higher): the bust framing frames the hair too, and long hair
+# reaching the shoulders takes the frame's bottom down to about -0.45
+BUST_END = tuple(build_bust.RINGS[-2:, 0])
 SOCKET = 0.006  # metres from the eyeball's surface: the skin the eyeball is fitted to
 
 

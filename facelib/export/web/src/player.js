@@ -6,6 +6,7 @@ import { GLTFLoader } from "three/examples/jsm/loaders/GLTFLoader.js";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 import { arkitMeshes, connectLive } from "./live.js";
 
+const AUDIO_TRUST_S = 0.25; // the audio's clock is the face's within this of the page's
 const scene = window.FACELIB_SCENE; // {glb: base64, look: {...}, audio, audioOffset}
 const params = new URLSearchParams(window.location.search);
 
@@ -163,9 +164,20 @@ function fileMode(v, gltf) {
   }
   function tick() {
     if (playing) {
-      // the audio is the clock while it plays; before it starts, the page's own clock
-      const audioClock = hasAudio && !audio.paused ? audio.currentTime + scene.audioOffset : null;
-      const t = audioClock ?? performance.now() / 1000 - started;
+      // the audio is the clock while it plays, the page's own clock before it starts and
+      // whenever the audio's is not to be trusted: while it seeks, or far from the page's
+      // (a slow machine that has just started the audio reports 0 for a while: the face
+      // jumped back to the start)
+      let t = performance.now() / 1000 - started;
+      if (hasAudio && !audio.paused && !audio.seeking) {
+        const heard = audio.currentTime + scene.audioOffset;
+        if (Math.abs(heard - t) < AUDIO_TRUST_S) {
+          t = heard;
+          started = performance.now() / 1000 - t;
+        } else {
+          audio.currentTime = Math.max(t - scene.audioOffset, 0);  // bring the sound along
+        }
+      }
       if (hasAudio && audio.paused && t >= scene.audioOffset && t < duration) {
         audio.currentTime = t - scene.audioOffset;
         audio.play().catch(() => {});
