@@ -12,7 +12,8 @@ front to back by ``tilt`` (metres at the front, the opposite at the back), with 
 spline through them along every column of the loop, so the surface starts on the head's own
 loop vertices (the bust's first row *is* the loop: no gap, and smooth normals across the
 seam, since the renderer averages the normals of both sides' triangles there) and flares into
-the shoulders. The first rings blend the loop's own shape into the ellipses.
+the shoulders. The first two rings carry the head's neck on at its own slope (see
+:func:`ring_points`), the third blends the loop's own shape into the ellipses.
 
 The garment is a second surface 4 mm outside the skin from a neckline down (lower at the front,
 a slight scoop), its top edge rolled into a ribbed collar that tucks 1 mm under the skin.
