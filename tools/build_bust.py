@@ -59,7 +59,7 @@ RINGS = np.array([
     (-0.460, 0.000, 0.186, 0.112, 2.6, -0.008),  # the last two low enough that the bust
     (-0.620, 0.000, 0.180, 0.113, 2.5, -0.008),  # framing of long hair shows no cut edge
 ])
-LOOP_SHAPE = (0.8, 0.5, 0.25)  # how much of the loop's own shape rings 0, 1 and 2 keep
+LOOP_SHAPE = 0.25  # how much of the loop's own shape ring 2 keeps
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
 NECK_REACH = 5  # edges up the head's neck that set the bust's first direction
 NECK_DESCENT = (0.25, 0.6)  # rings 0, 1 at these shares of the loop's drop to ring 2
@@ -130,29 +130,27 @@ def ring_points(loop: np.ndarray, slope: np.ndarray, rings: np.ndarray = RINGS) 
     theta_loop, even = even_angles(loop)
     r_loop = np.hypot(rel[:, 0], rel[:, 2])
     descent = len(NECK_DESCENT)
+
+    def angles(k: int) -> np.ndarray:
+        u = EVEN_COLUMNS[min(k, len(EVEN_COLUMNS) - 1)]
+        return (1 - u) * theta_loop + u * even
+
+    y2, tilt2 = rings[descent, :2]
+    below = y2 + tilt2 * np.cos(angles(descent)) - loop[:, 1]  # each column's drop to ring 2
     out = [loop]
     for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
-        u = EVEN_COLUMNS[min(k, len(EVEN_COLUMNS) - 1)]
-        theta = (1 - u) * theta_loop + u * even
+        theta = angles(k)
+        own = np.interp(theta, theta_loop, r_loop, period=2 * np.pi)
         r = superellipse_radius(theta, a, b, n) * (1 - arm_creases(theta, k))
-        zc = ring_z
-        heights = y + tilt * np.cos(theta)
-        if k < len(LOOP_SHAPE):
-            w = LOOP_SHAPE[k]
-            own = np.interp(theta, theta_loop, r_loop, period=2 * np.pi)
-            r = np.maximum(w * own + (1 - w) * r, own)
-            zc = w * centre[2] + (1 - w) * ring_z
+        zc, heights = ring_z, y + tilt * np.cos(theta)
+        if k < descent:
+            drop = NECK_DESCENT[k] * below
+            r, zc, heights = own - slope * drop, centre[2], loop[:, 1] + drop
+        elif k == descent:
+            r = np.maximum(LOOP_SHAPE * own + (1 - LOOP_SHAPE) * r, own)
+            zc = LOOP_SHAPE * centre[2] + (1 - LOOP_SHAPE) * ring_z
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
-    out = np.array(out)
-    share = np.array(NECK_DESCENT)[:, None]
-    drop = share * (out[descent + 1, :, 1] - loop[:, 1])
-    out[1:descent + 1, :, 1] = loop[:, 1] + drop
-    for k in range(descent):
-        theta = (1 - EVEN_COLUMNS[k]) * theta_loop + EVEN_COLUMNS[k] * even
-        own = np.interp(theta, theta_loop, r_loop, period=2 * np.pi) - slope * drop[k]
-        out[k + 1, :, 0] = own * np.sin(theta)
-        out[k + 1, :, 2] = centre[2] + own * np.cos(theta)
-    return out
+    return np.array(out)
 
 
 def neck_slopes(loop: np.ndarray, arrival: np.ndarray) -> np.ndarray:

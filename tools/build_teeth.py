@@ -48,12 +48,13 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+import build_tracking_embedding
 import numpy as np
+from build_tracking_embedding import EMBEDDING
 from scipy.interpolate import CubicSpline
 
 ROOT = Path(__file__).resolve().parent.parent
 HEAD = ROOT / "facelib" / "data" / "head"
-EMBEDDING = ROOT / "facelib" / "data" / "tracking" / "default_head_mediapipe.json"
 SEED = 31
 
 # The MakeHuman slabs' rows (mm, head frame: +x the face's left, +y up, +z forward), from the
@@ -632,8 +633,6 @@ def main(*, write: bool = True, tracking: bool = True, bake: bool = True) -> Non
         # the MediaPipe embedding found afresh on the new head (needs the ``render`` and
         # ``track`` extras): the open mouth that it is found on looks different now, so
         # MediaPipe's fit moves, and the remapped ids alone no longer match a fresh run
-        import build_tracking_embedding
-
         build_tracking_embedding.main()
 
 

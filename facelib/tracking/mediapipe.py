@@ -161,6 +161,13 @@ class FaceMeshTracker:
         self._previous: np.ndarray | None = (  # the box of the face kept last
             None if follow is None else np.array(follow, np.float64))
 
+    def _process(self, rgb: np.ndarray) -> list[Any]:
+        """MediaPipe's face landmarks of ``rgb`` (its result objects; empty: no face)."""
+        assert self._mesh is not None
+        # the landmark stages warn as they first see a face
+        with nullcontext() if self._seen_face else _native_stderr_logged():
+            return list(self._mesh.process(rgb).multi_face_landmarks or [])
+
     def detect(self, image: np.ndarray) -> FaceLandmarks | None:
         """Landmarks of the face kept in ``image`` (``(H, W, 3) uint8`` RGB), or None if
         there is no face."""
@@ -168,20 +175,13 @@ class FaceMeshTracker:
             raise TrackingError("this FaceMeshTracker is closed")
         rgb = _check_image(image)
         height, width = rgb.shape[:2]
-        if self._seen_face:
-            result = self._mesh.process(rgb)
-        else:  # the landmark stages warn as they first see a face
-            with _native_stderr_logged():
-                result = self._mesh.process(rgb)
-        faces = result.multi_face_landmarks or []
+        faces = self._process(rgb)
         if faces and self._video and not self._held:
             # a face found afresh is read in the face detector's box and tilt, which sit it
             # less well (a face lying on its side: chin to nose tip 5 % longer than in the
             # frames after, and a neutral taken over the first frames carried it); the frame
             # is read again as the next would be, in the box of the landmarks just found
-            with _native_stderr_logged() if not self._seen_face else nullcontext():
-                result = self._mesh.process(rgb)
-            faces = result.multi_face_landmarks or faces
+            faces = self._process(rgb) or faces
         self._held = bool(faces)
         if not faces:
             return None
