@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from types import MappingProxyType
 from typing import Any
 
@@ -33,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from facelib.checks import check_count
-from facelib.engine import rigid
+from facelib.engine import fused, rigid
 from facelib.engine.deformers import Deformer, FrameStep, RegionSetup, deformer
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.riders import Riders, no_riders
@@ -71,6 +72,11 @@ _BLOCK = 32  # frames deformed together
 def _column(name: str) -> int:
     """The 0-based column of the FAP called ``name`` in a frame of 84 values."""
     return fap(name).index
+
+
+def _columns_of(names: tuple[str, str, str]) -> tuple[int, int, int]:
+    a, b, c = (_column(name) for name in names)
+    return a, b, c
 
 
 def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
@@ -368,11 +374,25 @@ class Face:
             raise ParameterError("deform_frame() got a non-finite FAP value")
         return self._deform(values[None, :])[0]
 
+    @cached_property
+    def _plan(self) -> fused.Plan:
+        """The compiled kernel's constant inputs (:mod:`facelib.engine.fused`)."""
+        return fused.make_plan(self.vertices, self.operator, self._rigid, self.fapu,
+                               jaw=_columns_of(_JAW), head=_columns_of(_HEAD))
+
     def _active(self, f: np.ndarray) -> np.ndarray:
         """Indices of the FAPs that move a vertex and are non-zero somewhere in ``f``."""
         return np.flatnonzero(np.any(self._dense != 0, axis=1) & np.any(f != 0, axis=0))
 
     def _deform(self, f: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
+        """``f`` (n, 84) float32 -> (n, V, 3) float32: the compiled kernel where numba is
+        installed and no region needs an exact per-frame step, else :meth:`_deform_numpy`."""
+        if not self._steps and fused.available():
+            return fused.deform(self._plan, f)
+        return self._deform_numpy(f, active)
+
+    def _deform_numpy(self, f: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
+        """The numpy path (and the kernel's reference): blocks of frames, step by step."""
         n, nv = f.shape[0], self.n_vertices
         out = np.empty((n, nv, 3), np.float32)
         if active is None:

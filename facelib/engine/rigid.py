@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["hinge_angle", "rotate_about_x", "rotate_weighted", "rotation_matrices"]
+__all__ = ["hinge_angle", "rotate_about_x", "rotate_weighted", "rotation_matrices",
+           "weighted_terms"]
 
 
 def rotation_matrices(pitch: np.ndarray, yaw: np.ndarray, roll: np.ndarray) -> np.ndarray:
@@ -83,6 +84,36 @@ def rotate_about_x(
     return y * c - z * s + pivot_y, y * s + z * c + pivot_z
 
 
+def weighted_terms(
+    rotations: np.ndarray, weights: np.ndarray, dtype: type = np.float32
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The per-frame, per-point terms of :func:`rotate_weighted` (Rodrigues' formula).
+
+    Parameters
+    ----------
+    rotations: (n, 3, 3) rotation matrices.
+    weights: (K,) float in [0, 1], the fraction of each frame's angle a point turns by.
+    dtype: the points' float type.
+
+    Returns
+    -------
+    ``cross`` (n, 3, 3) with ``v @ cross[i]`` the cross product of frame i's unit axis with
+    ``v``; ``sin(phi)`` and ``1 - cos(phi)``, each (n, K), ``phi`` the angle of each point.
+    """
+    trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(trace)
+    x, y, z = (rotations[:, 2, 1] - rotations[:, 1, 2], rotations[:, 0, 2] - rotations[:, 2, 0],
+               rotations[:, 1, 0] - rotations[:, 0, 1])
+    norm = np.sqrt(x * x + y * y + z * z)
+    scale = np.divide(1.0, norm, out=np.zeros_like(norm), where=norm > 1e-15)
+    x, y, z = x * scale, y * scale, z * scale
+    zero = np.zeros_like(x)
+    cross = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
+                      np.stack([y, -x, zero], -1)], -2).astype(dtype)
+    phi = (angle[:, None] * weights[None, :]).astype(dtype)  # (n, K)
+    return cross, np.sin(phi), 1.0 - np.cos(phi)
+
+
 def rotate_weighted(
     points: np.ndarray, pivot: np.ndarray, rotations: np.ndarray, weights: np.ndarray
 ) -> np.ndarray:
@@ -102,24 +133,13 @@ def rotate_weighted(
     -------
     (n, K, 3), the dtype of ``points``.
     """
-    trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(trace)
-    x, y, z = (rotations[:, 2, 1] - rotations[:, 1, 2], rotations[:, 0, 2] - rotations[:, 2, 0],
-               rotations[:, 1, 0] - rotations[:, 0, 1])
-    norm = np.sqrt(x * x + y * y + z * z)
-    scale = np.divide(1.0, norm, out=np.zeros_like(norm), where=norm > 1e-15)
-    x, y, z = x * scale, y * scale, z * scale
-    zero = np.zeros_like(x)
-    # v @ cross[i] is axis[i] x v
-    cross = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
-                      np.stack([y, -x, zero], -1)], -2).astype(points.dtype)
-    phi = (angle[:, None] * weights[None, :]).astype(points.dtype)  # (n, K)
+    cross, sin, one_minus_cos = weighted_terms(rotations, weights, points.dtype.type)
     pivot = np.asarray(pivot, dtype=points.dtype)
     v = points - pivot
     kv = v @ cross
     kkv = kv @ cross  # axis x (axis x v)
-    kv *= np.sin(phi)[..., None]
-    kkv *= (1.0 - np.cos(phi))[..., None]
+    kv *= sin[..., None]
+    kkv *= one_minus_cos[..., None]
     v += kv
     v += kkv
     v += pivot
