@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["hinge_angle", "rotate_about_x", "rotate_weighted", "rotation_matrices",
-           "weighted_terms"]
+__all__ = ["axis_angle", "hinge_angle", "rotate_about_x", "rotate_weighted",
+           "rotation_matrices"]
 
 
 def rotation_matrices(pitch: np.ndarray, yaw: np.ndarray, roll: np.ndarray) -> np.ndarray:
@@ -84,21 +84,18 @@ def rotate_about_x(
     return y * c - z * s + pivot_y, y * s + z * c + pivot_z
 
 
-def weighted_terms(
-    rotations: np.ndarray, weights: np.ndarray, dtype: type = np.float32
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The per-frame, per-point terms of :func:`rotate_weighted` (Rodrigues' formula).
+def axis_angle(rotations: np.ndarray, dtype: type = np.float32) -> tuple[np.ndarray, np.ndarray]:
+    """Each rotation's unit axis, as a cross-product matrix, and its angle.
 
     Parameters
     ----------
     rotations: (n, 3, 3) rotation matrices.
-    weights: (K,) float in [0, 1], the fraction of each frame's angle a point turns by.
-    dtype: the points' float type.
+    dtype: the float type of the matrices returned.
 
     Returns
     -------
-    ``cross`` (n, 3, 3) with ``v @ cross[i]`` the cross product of frame i's unit axis with
-    ``v``; ``sin(phi)`` and ``1 - cos(phi)``, each (n, K), ``phi`` the angle of each point.
+    ``cross`` (n, 3, 3) ``dtype``, with ``v @ cross[i]`` the cross product of frame i's unit
+    axis with ``v`` (zero where the rotation is none); ``angle`` (n,) float64 radians.
     """
     trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     angle = np.arccos(trace)
@@ -110,8 +107,7 @@ def weighted_terms(
     zero = np.zeros_like(x)
     cross = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
                       np.stack([y, -x, zero], -1)], -2).astype(dtype)
-    phi = (angle[:, None] * weights[None, :]).astype(dtype)  # (n, K)
-    return cross, np.sin(phi), 1.0 - np.cos(phi)
+    return cross, angle
 
 
 def rotate_weighted(
@@ -133,13 +129,14 @@ def rotate_weighted(
     -------
     (n, K, 3), the dtype of ``points``.
     """
-    cross, sin, one_minus_cos = weighted_terms(rotations, weights, points.dtype.type)
+    cross, angle = axis_angle(rotations, points.dtype.type)
+    phi = (angle[:, None] * weights[None, :]).astype(points.dtype)  # (n, K)
     pivot = np.asarray(pivot, dtype=points.dtype)
     v = points - pivot
     kv = v @ cross
     kkv = kv @ cross  # axis x (axis x v)
-    kv *= sin[..., None]
-    kkv *= one_minus_cos[..., None]
+    kv *= np.sin(phi)[..., None]
+    kkv *= (1.0 - np.cos(phi))[..., None]
     v += kv
     v += kkv
     v += pivot
