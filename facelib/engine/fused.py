@@ -41,10 +41,10 @@ def _kernel() -> Callable[..., None] | None:
     if os.environ.get("FACELIB_JIT", "1") == "0":
         return None
     try:
-        from facelib.engine.fused_kernel import deform_frames  # noqa: PLC0415
+        from facelib.engine.fused_kernel import deform_frames
     except ImportError:
         return None
-    return deform_frames  # type: ignore[no-any-return]
+    return deform_frames
 
 
 def available() -> bool:
@@ -138,7 +138,7 @@ def _ids(columns: np.ndarray) -> np.ndarray:
 def _eye_parts(eyes: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Both eyes' spans (S, 4), rest shapes about their centres (E, 3) and centres (2, 3)."""
     spans, local, at = [], [], 0
-    for e, (cols, rest, tiled, *_) in enumerate(eyes):
+    for e, (cols, rest, *_) in enumerate(eyes):
         ids = _ids(cols)
         order = np.argsort(ids, kind="stable")
         part = _vertex_spans(ids[order])

@@ -18,6 +18,9 @@ together (to keep each tile's inputs in the cache) was slower, the calls per til
 strided writes costing more than the reuse saved.
 """
 
+# numba kernels take their arrays positionally (keyword-only arguments do not compile)
+# ruff: noqa: PLR0917
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,7 +39,7 @@ _PIO2_HI, _PIO2_LO = 1.5707963267341256, 6.077100506506192e-11  # pi/2 in two pa
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _sincos(x):  # type: ignore[no-untyped-def]
+def _sincos(x):
     """``(sin x, cos x)`` in float64 for ``|x|`` up to about 1e5, branch-free (so that loops
     calling it vectorise): the quadrant ``q`` by rounding, then the series about it."""
     q = np.floor(x * (2 / np.pi) + 0.5)
@@ -46,18 +49,18 @@ def _sincos(x):  # type: ignore[no-untyped-def]
     c = 1.0 + r2 * (_C2 + r2 * (_C4 + r2 * (_C6 + r2 * (_C8 + r2 * (_C10 + r2 * (
         _C12 + r2 * _C14))))))
     m = q - 4.0 * np.floor(q * 0.25)  # the quadrant, 0-3
-    odd = m == 1.0 or m == 3.0
+    odd = (m == 1.0) | (m == 3.0)
     sin = c if odd else s
     cos = s if odd else c
     if m >= 2.0:
         sin = -sin
-    if m == 1.0 or m == 2.0:
+    if (m == 1.0) | (m == 2.0):
         cos = -cos
     return sin, cos
 
 
 @njit(cache=True, nogil=True)
-def _product(o, ft, runs, data, lo, hi):  # type: ignore[no-untyped-def]
+def _product(o, ft, runs, data, lo, hi):
     """``o (3V,) += ft @ A`` over runs ``lo:hi``: rows of ``runs`` (R, 4) uint64 are (first
     column, stop column, offset into ``data`` (float32), FAP column)."""
     for r in range(lo, hi):
@@ -69,7 +72,7 @@ def _product(o, ft, runs, data, lo, hi):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _lid_trig(weights, angles, total, cos, sin):  # type: ignore[no-untyped-def]
+def _lid_trig(weights, angles, total, cos, sin):
     """Each lid vertex's angle: its regions' ``angles`` (R,) float64 weighted by ``weights``
     (R, K) float64, added in region order into ``total`` (K,) float64; its cosine and sine
     into ``cos``, ``sin`` (K,) float32 (of the angle rounded to float32, as numpy's)."""
@@ -84,7 +87,7 @@ def _lid_trig(weights, angles, total, cos, sin):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _lids(o, spans, lo, hi, pivots, cos, sin):  # type: ignore[no-untyped-def]
+def _lids(o, spans, lo, hi, pivots, cos, sin):
     """Turn the lid vertices of spans ``lo:hi`` about x by their ``cos``, ``sin`` (K,)
     float32, about their eye centres ``pivots`` (2, K) float32 (y, z)."""
     for r in range(lo, hi):
@@ -98,7 +101,7 @@ def _lids(o, spans, lo, hi, pivots, cos, sin):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _eyes(o, spans, lo, hi, local, centre, on, rot, thrust):  # type: ignore[no-untyped-def]
+def _eyes(o, spans, lo, hi, local, centre, on, rot, thrust):
     """Place the eyeballs that move (``on`` (2,) bool) over spans ``lo:hi`` (the eye in
     column 3): a vertex is ``rot[e] @ local + (0, 0, thrust[e]) + centre[e]``, ``local``
     (E, 3) float32 its rest position about the eye's centre."""
@@ -116,7 +119,7 @@ def _eyes(o, spans, lo, hi, local, centre, on, rot, thrust):  # type: ignore[no-
 
 
 @njit(cache=True, nogil=True)
-def _jaw(o, spans, lo, hi, pivot, jaw):  # type: ignore[no-untyped-def]
+def _jaw(o, spans, lo, hi, pivot, jaw):
     """Hinge the jaw's vertices (spans ``lo:hi``) about x through ``pivot`` (3,) float64;
     ``jaw`` (4,) float32 is cos, sin, the thrust and the shift. The turn runs in float64,
     as the numpy path's does."""
@@ -134,7 +137,7 @@ def _jaw(o, spans, lo, hi, pivot, jaw):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _neck(o, spans, lo, hi, pivot, weights, cross, angle, out):  # type: ignore[no-untyped-def]
+def _neck(o, spans, lo, hi, pivot, weights, cross, angle, out):
     """The partly turned neck vertices of spans ``lo:hi`` (Rodrigues), into ``out`` (3K,)
     float32: vertex k turns about ``pivot`` (3,) by ``weights[k]`` (float32) of ``angle``
     (float64) about the axis whose cross-product matrix is ``cross`` (3, 3):
@@ -159,7 +162,7 @@ def _neck(o, spans, lo, hi, pivot, weights, cross, angle, out):  # type: ignore[
 
 
 @njit(cache=True, nogil=True)
-def _put(o, spans, lo, hi, values):  # type: ignore[no-untyped-def]
+def _put(o, spans, lo, hi, values):
     """Write ``values`` (3K,) float32 to the vertices of spans ``lo:hi``."""
     for r in range(lo, hi):
         first, at = spans[r, 0], spans[r, 2]
@@ -169,7 +172,7 @@ def _put(o, spans, lo, hi, values):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _head(o, spans, lo, hi, pivot, turned):  # type: ignore[no-untyped-def]
+def _head(o, spans, lo, hi, pivot, turned):
     """Turn the vertices of spans ``lo:hi`` about ``pivot`` (3,) float32 in place:
     ``p' = (p - pivot) @ turned + pivot``, ``turned`` (3, 3) float32 = R^T."""
     px, py, pz = pivot[0], pivot[1], pivot[2]
@@ -186,7 +189,7 @@ def _head(o, spans, lo, hi, pivot, turned):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _start(o, rest, plain, busy, pivot, turned):  # type: ignore[no-untyped-def]
+def _start(o, rest, plain, busy, pivot, turned):
     """Start a turning frame: the vertices only the head moves (spans ``plain``) turned
     straight from ``rest`` (as :func:`_head` turns them), the others (``busy``) copied."""
     px, py, pz = pivot[0], pivot[1], pivot[2]
@@ -206,7 +209,7 @@ def _start(o, rest, plain, busy, pivot, turned):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def _rigid(o, lids, eyes, jaw, head, on):  # type: ignore[no-untyped-def]
+def _rigid(o, lids, eyes, jaw, head, on):
     """The rigid steps of one frame on ``o`` (3V,): lids, eyes, jaw, head (each its argument
     tuple; ``on`` (lids, jaw, head) says which move this frame)."""
     if on[0]:
@@ -230,7 +233,7 @@ def deform_frames(out, f, rest, runs, data,
                   eye_spans, eye_local, eye_centre, eye_on, eye_rot, eye_thrust,
                   jaw_spans, jaw_pivot, jaw_on, jaw,
                   head_spans, plain_spans, busy_spans, neck_spans, neck_weights, head_pivot,
-                  head_on, head_turned, neck_cross, neck_angle):  # type: ignore[no-untyped-def]
+                  head_on, head_turned, neck_cross, neck_angle):
     """Deform ``out`` (n, 3V) float32 from ``f`` (n, 84) float32, frame by frame.
 
     ``head_spans`` are the vertices the head turns that another step moves too (those it

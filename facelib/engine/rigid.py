@@ -105,8 +105,9 @@ def axis_angle(rotations: np.ndarray, dtype: type = np.float32) -> tuple[np.ndar
     scale = np.divide(1.0, norm, out=np.zeros_like(norm), where=norm > 1e-15)
     x, y, z = x * scale, y * scale, z * scale
     zero = np.zeros_like(x)
-    cross = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
-                      np.stack([y, -x, zero], -1)], -2).astype(dtype)
+    # v @ cross[i] is axis[i] x v
+    cross: np.ndarray = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
+                                  np.stack([y, -x, zero], -1)], -2).astype(dtype)
     return cross, angle
 
 
