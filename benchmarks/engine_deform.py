@@ -16,7 +16,8 @@ The first call in a process pays for the operating system's first touch of the o
 pages (a few times slower for all three); a warm-up call runs before the timings. Then, in
 fresh processes, the cost of the first deformation of a 3 s clip with each path: numba's
 import and the load of its cached machine code (or, the very first time, its compilation)
-against the numpy path's first call.
+against the numpy path's first call (``deform`` itself keeps streams this short on the numpy
+path; see ``facelib.engine.face._KERNEL_FROM``).
 """
 
 from __future__ import annotations
@@ -38,13 +39,12 @@ FIRST_CALL = """
 import time
 start = time.perf_counter()
 import numpy as np
-from facelib.engine import load_face
-from facelib.mpeg4.stream import FapStream
+from facelib.engine import fused, load_face
 face = load_face()
 values = np.zeros((75, 84), np.float32)
 values[:, 48] = 5000.0 * np.sin(np.arange(75) / 10.0)
 loaded = time.perf_counter()
-face.deform(FapStream(25.0, values, values != 0))
+face._deform(values, kernel=fused.available())  # deform() itself takes numpy for 75 frames
 print(time.perf_counter() - loaded)
 """
 
@@ -102,6 +102,7 @@ def main() -> None:
     def numpy_path(s: FapStream) -> None:
         face._deform_numpy(np.asarray(s.values, np.float32))
 
+    assert not compiled or face._kernel_for(int(FPS * SECONDS))  # deform() takes the kernel
     runs = [face.deform, numpy_path, lambda s: ceiling(face, s)]
     for name, kinds in (("translations only", linear), ("+ eyes and lids", eyes),
                         ("everything (jaw, head)", everything)):

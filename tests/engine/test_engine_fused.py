@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from facelib.engine import default_face, fused, load_face
+from facelib.engine import face as face_module
 from facelib.mpeg4.stream import FapStream
 from facelib.mpeg4.tables import fap_table
 
@@ -52,11 +53,18 @@ def faces():
     return dict(_faces())
 
 
+@pytest.fixture
+def short_streams_too(monkeypatch):
+    """Short streams take the kernel too (normally from about 1,000 frames)."""
+    monkeypatch.setattr(face_module, "_KERNEL_FROM", 0)
+
+
 @pytest.mark.parametrize("name", ["default", "ada", "soffd lips"])
-def test_kernel_equals_the_numpy_path_to_float32_rounding(faces, name: str) -> None:
+def test_kernel_equals_the_numpy_path_to_float32_rounding(faces, short_streams_too,
+                                                           name: str) -> None:
     face = faces[name]
-    assert not face._steps  # no exact per-frame step: deform takes the kernel
     stream = _stream()
+    assert face._kernel_for(stream.n_frames)  # no exact per-frame step: the kernel runs
     values = np.asarray(stream.values, np.float32)
     kernel = face.deform(stream)
     reference = face._deform_numpy(values)
@@ -70,28 +78,36 @@ def test_kernel_equals_the_numpy_path_to_float32_rounding(faces, name: str) -> N
         assert moved[:, face.parts[part].vertex_ids].max() > 1000 * 1e-6 * size, part
 
 
-def test_still_frames_are_the_rest_shape(faces) -> None:
+def test_still_frames_are_the_rest_shape(faces, short_streams_too) -> None:
     face = faces["default"]
     values = np.zeros((3, 84), np.float32)
     out = face.deform(FapStream(25.0, values, values != 0))
     assert np.array_equal(out, np.broadcast_to(face.vertices, out.shape))
 
 
-def test_chunks_are_bit_for_bit_the_whole_stream(faces) -> None:
+def test_chunks_are_bit_for_bit_the_whole_stream(faces, short_streams_too) -> None:
     face = faces["default"]
     stream = _stream(53)
     whole = face.deform(stream)
     for frames in (1, 7, 32):
         stacked = np.concatenate([b for _, b in face.deform_chunks(stream, frames=frames)])
         assert np.array_equal(stacked, whole), frames
-    one = face.deform_frame(np.asarray(stream.values[17], np.float32))
-    assert np.array_equal(one, whole[17])
+
+
+def test_short_streams_and_single_frames_take_the_numpy_path(faces) -> None:
+    face = faces["default"]
+    assert not face._kernel_for(500)  # 500 frames: loading the kernel would cost more
+    assert face._kernel_for(1500)
+    stream = _stream(5)
+    values = np.asarray(stream.values, np.float32)
+    assert np.array_equal(face.deform(stream), face._deform_numpy(values))
+    assert np.array_equal(face.deform_frame(values[3]), face._deform_numpy(values[3:4])[0])
 
 
 def test_sines_and_cosines_are_those_of_numpy() -> None:
-    from facelib.engine.fused_kernel import _sincos  # noqa: PLC0415
+    from numba import njit
 
-    from numba import njit  # noqa: PLC0415
+    from facelib.engine.fused_kernel import _sincos
 
     @njit
     def both(x):  # type: ignore[no-untyped-def]
