@@ -505,6 +505,26 @@ def _opened(path: str | os.PathLike[str]
         raise
 
 
+def _faces_and_video(
+    path: str | os.PathLike[str], wanted: int,
+) -> tuple[_Faces, tuple[VideoInfo, Generator[np.ndarray, None, None], np.ndarray | None]]:
+    """MediaPipe's graphs for ``wanted`` faces and the opened video (:func:`_opened`),
+    ffmpeg probing and decoding while the graphs load; neither is left open on an error."""
+    with ThreadPoolExecutor(1) as pool:
+        opening = pool.submit(_opened, path)
+        try:
+            faces = _Faces(wanted)
+        except BaseException:
+            with suppress(BaseException):
+                opening.result()[1].close()
+            raise
+        try:
+            return faces, opening.result()
+        except BaseException:
+            faces.close()
+            raise
+
+
 def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
                 max_faces: int = 2, _brows: _BrowPass | None = None) -> VideoTrack:
     """Track a face through a video with MediaPipe's face mesh (the largest at first, then
@@ -516,20 +536,8 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
     (:class:`TrackingWarning`) naming the frames with several faces.
     """
     limit = None if max_frames is None else check_count("max_frames", max_frames, low=1)
-    wanted = check_count("max_faces", max_faces, low=1)
-    with ThreadPoolExecutor(1) as pool:  # ffmpeg probes and decodes while the graphs load
-        opening = pool.submit(_opened, path)
-        try:
-            faces = _Faces(wanted)
-        except BaseException:
-            with suppress(BaseException):
-                opening.result()[1].close()
-            raise
-        try:
-            info, ahead, first = opening.result()
-        except BaseException:
-            faces.close()
-            raise
+    faces, (info, ahead, first) = _faces_and_video(
+        path, check_count("max_faces", max_faces, low=1))
     points: list[np.ndarray] = []
     light: list[float] = []
     lost = np.full((N_LANDMARKS, 3), np.nan)
