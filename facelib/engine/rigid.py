@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["hinge_angle", "rotate_about_x", "rotate_weighted", "rotation_matrices"]
+__all__ = ["axis_angle", "hinge_angle", "rotate_about_x", "rotate_weighted",
+           "rotation_matrices"]
 
 
 def rotation_matrices(pitch: np.ndarray, yaw: np.ndarray, roll: np.ndarray) -> np.ndarray:
@@ -83,6 +84,33 @@ def rotate_about_x(
     return y * c - z * s + pivot_y, y * s + z * c + pivot_z
 
 
+def axis_angle(rotations: np.ndarray, dtype: type = np.float32) -> tuple[np.ndarray, np.ndarray]:
+    """Each rotation's unit axis, as a cross-product matrix, and its angle.
+
+    Parameters
+    ----------
+    rotations: (n, 3, 3) rotation matrices.
+    dtype: the float type of the matrices returned.
+
+    Returns
+    -------
+    ``cross`` (n, 3, 3) ``dtype``, with ``v @ cross[i]`` the cross product of frame i's unit
+    axis with ``v`` (zero where the rotation is none); ``angle`` (n,) float64 radians.
+    """
+    trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(trace)
+    x, y, z = (rotations[:, 2, 1] - rotations[:, 1, 2], rotations[:, 0, 2] - rotations[:, 2, 0],
+               rotations[:, 1, 0] - rotations[:, 0, 1])
+    norm = np.sqrt(x * x + y * y + z * z)
+    scale = np.divide(1.0, norm, out=np.zeros_like(norm), where=norm > 1e-15)
+    x, y, z = x * scale, y * scale, z * scale
+    zero = np.zeros_like(x)
+    # v @ cross[i] is axis[i] x v
+    cross: np.ndarray = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
+                                  np.stack([y, -x, zero], -1)], -2).astype(dtype)
+    return cross, angle
+
+
 def rotate_weighted(
     points: np.ndarray, pivot: np.ndarray, rotations: np.ndarray, weights: np.ndarray
 ) -> np.ndarray:
@@ -102,17 +130,7 @@ def rotate_weighted(
     -------
     (n, K, 3), the dtype of ``points``.
     """
-    trace = np.clip((np.trace(rotations, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(trace)
-    x, y, z = (rotations[:, 2, 1] - rotations[:, 1, 2], rotations[:, 0, 2] - rotations[:, 2, 0],
-               rotations[:, 1, 0] - rotations[:, 0, 1])
-    norm = np.sqrt(x * x + y * y + z * z)
-    scale = np.divide(1.0, norm, out=np.zeros_like(norm), where=norm > 1e-15)
-    x, y, z = x * scale, y * scale, z * scale
-    zero = np.zeros_like(x)
-    # v @ cross[i] is axis[i] x v
-    cross = np.stack([np.stack([zero, z, -y], -1), np.stack([-z, zero, x], -1),
-                      np.stack([y, -x, zero], -1)], -2).astype(points.dtype)
+    cross, angle = axis_angle(rotations, points.dtype.type)
     phi = (angle[:, None] * weights[None, :]).astype(points.dtype)  # (n, K)
     pivot = np.asarray(pivot, dtype=points.dtype)
     v = points - pivot

@@ -18,6 +18,7 @@ patch covers the same part of any face at any resolution.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from functools import cache
@@ -171,8 +172,12 @@ def _sample(grey: np.ndarray, points: np.ndarray, pose: HeadPose, i: int) -> np.
 def _seen(points: np.ndarray, pose: HeadPose, i: int) -> tuple[np.ndarray, np.ndarray]:
     """``(..., 3)`` neutral face-frame points seen in frame ``i`` through ``pose``: their
     image columns and rows, ``(...)`` float32 each."""
-    seen = pose.scale[i] * points @ pose.rotation[i].T + pose.translation[i]
-    return seen[..., 0].astype(np.float32), (-seen[..., 1]).astype(np.float32)
+    # the image's two axes alone, as one product over the points: the same sums of three
+    # products as over all three axes point by point, at half the time
+    seen = (pose.scale[i] * points).reshape(-1, 3) @ pose.rotation[i, :2].T
+    shape = points.shape[:-1]
+    return ((seen[:, 0] + pose.translation[i, 0]).astype(np.float32).reshape(shape),
+            (-(seen[:, 1] + pose.translation[i, 1])).astype(np.float32).reshape(shape))
 
 
 def brow_patches(images: Iterable[np.ndarray], landmarks: np.ndarray, neutral: Neutral,
@@ -255,8 +260,8 @@ def _register(image: np.ndarray, patches: BrowPatches, pose: HeadPose, i: int
         if not np.isfinite([low, high]).all():
             box.append((0, size))
             continue
-        start = int(np.clip(np.floor(low) - 1, 0, size - 1))
-        box.append((start, int(np.clip(np.ceil(high) + 2, start + 1, size))))
+        start = min(max(math.floor(low) - 1, 0), size - 1)
+        box.append((start, min(max(math.ceil(high) + 2, start + 1), size)))
     (left, right), (top, bottom) = box
     grey = _grey(image[top:bottom, left:right])
     out = np.empty(N_FEATURES)

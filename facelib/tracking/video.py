@@ -11,15 +11,16 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import subprocess
 import tempfile
 import warnings
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import suppress
 from dataclasses import dataclass
 from functools import partial
-from itertools import islice
+from itertools import chain, islice
 from pathlib import Path
 from typing import Any
 
@@ -130,30 +131,58 @@ def _imageio_ffmpeg() -> Any:
     return require("ffmpeg_track")
 
 
-def _not_turned(record: logging.LogRecord) -> bool:
-    """imageio-ffmpeg's log, less its warning that the frames read are not the size
-    stored: ffmpeg turns the frames of a video that says it is rotated (a phone held
-    upright), as it should; :func:`read_video` says so at INFO."""
-    return "different from the source frame size" not in record.getMessage()
+_HEADER_TIMEOUT_S = 60
+"""Seconds ffmpeg may take to read a video's header (and first frame)."""
 
 
 def _probe(path: Path) -> dict[str, Any]:
-    """The metadata ffmpeg reports on ``path`` (decoding its first frame alone, on one
-    thread); TrackingError when it finds no video stream."""
-    reader = _imageio_ffmpeg().read_frames(str(path), pix_fmt="rgb24",
-                                           input_params=["-threads", "1"],
-                                           output_params=["-frames:v", "1"])
-    ffmpeg_log = logging.getLogger("imageio_ffmpeg")
-    ffmpeg_log.addFilter(_not_turned)
+    """What ffmpeg says of ``path``'s first video stream: ``fps`` (its average rate, 0 where
+    it gives none), ``size`` (width, height of the frames as read: turned as the file says),
+    ``source_size`` (as stored) and ``audio`` (whether the file has a sound stream).
+
+    ffmpeg reads the header alone (about 20 ms, one process) unless the stream carries side
+    data (a display matrix that turns the frames, say): then it also decodes the first frame
+    on one thread, so that ``size`` is the one it reads the frames at. TrackingError when it
+    finds no video stream."""
+    exe = _imageio_ffmpeg().get_ffmpeg_exe()
+    command = [exe, "-nostdin", "-hide_banner", "-threads", "1", "-i", str(path)]
+    text = _ffmpeg_says(command)
+    decoded = "side data" in text.lower()
+    if decoded:
+        text = _ffmpeg_says([*command, "-an", "-sn", "-dn", "-frames:v", "1", "-pix_fmt",
+                             "rgb24", "-c:v", "rawvideo", "-f", "null", "-"])
+    lines = text.splitlines()
+    video = [line for line in lines
+             if line.lstrip().startswith("Stream ") and " Video: " in line]
+    if not video or (decoded and not any(line.startswith("Output ") for line in lines)):
+        said = [line.strip() for line in lines if line.strip()] or ["no message"]
+        opened = any(line.startswith("Input #") for line in lines)
+        reason = "no video stream" if opened and not video else said[-1]
+        raise TrackingError(f"ffmpeg cannot read a video stream from it ({reason})", path=path)
+    rate = re.search(r" ([0-9]+\.?[0-9]*) fps", video[0])
+    return {"fps": float(rate.group(1)) if rate else 0.0,
+            "source_size": _frame_size(video[0]), "size": _frame_size(video[-1]),
+            "audio": any(line.lstrip().startswith("Stream ") and " Audio: " in line
+                         for line in lines)}
+
+
+def _ffmpeg_says(command: list[str]) -> str:
+    """What ffmpeg ``command`` writes to stderr (it may fail: ``-i`` alone always does)."""
     try:
-        return dict(next(reader))
-    except (OSError, RuntimeError, StopIteration) as exc:
-        first = (str(exc).strip().splitlines() or ["no message"])[0]
-        raise TrackingError(f"ffmpeg cannot read a video stream from it ({first})",
-                            path=path) from exc
-    finally:
-        reader.close()
-        ffmpeg_log.removeFilter(_not_turned)
+        done = subprocess.run(command, stdin=subprocess.DEVNULL, capture_output=True,
+                              timeout=_HEADER_TIMEOUT_S, check=False)
+    except subprocess.TimeoutExpired as exc:
+        raise TrackingError(f"ffmpeg took over {_HEADER_TIMEOUT_S} s to read its header",
+                            path=Path(command[command.index("-i") + 1])) from exc
+    return done.stderr.decode(errors="replace")
+
+
+def _frame_size(line: str) -> tuple[int, int]:
+    """The ``(width, height)`` an ffmpeg stream line gives (its first ``640x480``)."""
+    found = re.search(r" ([0-9]+)x([0-9]+)[, ]", line)
+    if found is None:
+        raise TrackingError(f"ffmpeg gives no frame size: {line.strip()!r}")
+    return int(found.group(1)), int(found.group(2))
 
 
 def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.ndarray]]:
@@ -176,11 +205,11 @@ def read_video(path: str | os.PathLike[str]) -> tuple[VideoInfo, Iterator[np.nda
     if fps != average:
         log.info("%s: read at %g frames a second (the video's average is %g)", path, fps,
                  average)
-    if tuple(meta.get("source_size", meta["size"])) != tuple(meta["size"]):
+    if meta["source_size"] != meta["size"]:
         log.info("%s: stored %s, read %s: ffmpeg turns the frames as the file says", path,
                  "x".join(map(str, meta["source_size"])), "x".join(map(str, meta["size"])))
     width, height = (int(v) for v in meta["size"])
-    info = VideoInfo(fps, width, height, bool(meta.get("audio_codec")))
+    info = VideoInfo(fps, width, height, meta["audio"])
     return info, _decode(path, fps, width, height)
 
 
@@ -198,6 +227,7 @@ def _decode(path: Path, fps: float, width: int, height: int) -> Iterator[np.ndar
             command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=errors) as ffmpeg:
         assert ffmpeg.stdout is not None
         _widen(ffmpeg.stdout.fileno(), size)
+        _behind(ffmpeg.pid)
         try:
             while raw := ffmpeg.stdout.read(size):
                 if len(raw) < size:
@@ -209,6 +239,20 @@ def _decode(path: Path, fps: float, width: int, height: int) -> Iterator[np.ndar
         finally:
             if ffmpeg.poll() is None:
                 ffmpeg.kill()
+
+
+_DECODER_NICE = 5
+"""How much nicer than this process the decoding ffmpeg runs: it has frames in hand (the
+pipe's and :func:`~facelib.tracking.overlap.read_ahead`'s), so where the two share a core,
+the tracker's threads come first."""
+
+
+def _behind(pid: int) -> None:
+    """Run process ``pid`` :data:`_DECODER_NICE` steps nicer than this one (at most 19);
+    where that cannot be done (not POSIX, refused) it runs as it is."""
+    with suppress(AttributeError, OSError):
+        here = os.getpriority(os.PRIO_PROCESS, 0)
+        os.setpriority(os.PRIO_PROCESS, pid, min(19, here + _DECODER_NICE))
 
 
 _PIPE_MAX = 1 << 20
@@ -447,6 +491,40 @@ def _after_landmarks(image: np.ndarray, points: np.ndarray, box: np.ndarray | No
     light.append(float("nan") if box is None else _face_light(image, box))
 
 
+def _opened(path: str | os.PathLike[str]
+            ) -> tuple[VideoInfo, Generator[np.ndarray, None, None], np.ndarray | None]:
+    """:func:`read_video` with the frames read ahead (:func:`read_ahead`) and the first of
+    them decoded (None: the video has none): ffmpeg's start and first frame while
+    MediaPipe's graphs load. Close the generator when done."""
+    info, decoded = read_video(path)
+    ahead = read_ahead(decoded)
+    try:
+        return info, ahead, next(ahead, None)
+    except BaseException:
+        ahead.close()
+        raise
+
+
+def _faces_and_video(
+    path: str | os.PathLike[str], wanted: int,
+) -> tuple[_Faces, tuple[VideoInfo, Generator[np.ndarray, None, None], np.ndarray | None]]:
+    """MediaPipe's graphs for ``wanted`` faces and the opened video (:func:`_opened`),
+    ffmpeg probing and decoding while the graphs load; neither is left open on an error."""
+    with ThreadPoolExecutor(1) as pool:
+        opening = pool.submit(_opened, path)
+        try:
+            faces = _Faces(wanted)
+        except BaseException:
+            with suppress(BaseException):
+                opening.result()[1].close()
+            raise
+        try:
+            return faces, opening.result()
+        except BaseException:
+            faces.close()
+            raise
+
+
 def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
                 max_faces: int = 2, _brows: _BrowPass | None = None) -> VideoTrack:
     """Track a face through a video with MediaPipe's face mesh (the largest at first, then
@@ -458,19 +536,12 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
     (:class:`TrackingWarning`) naming the frames with several faces.
     """
     limit = None if max_frames is None else check_count("max_frames", max_frames, low=1)
-    wanted = check_count("max_faces", max_faces, low=1)
-    with ThreadPoolExecutor(1) as pool:  # ffmpeg probes the video while the graphs load
-        probe = pool.submit(read_video, path)
-        faces = _Faces(wanted)
-        try:
-            info, decoded = probe.result()
-        except BaseException:
-            faces.close()
-            raise
+    faces, (info, ahead, first) = _faces_and_video(
+        path, check_count("max_faces", max_faces, low=1))
     points: list[np.ndarray] = []
     light: list[float] = []
     lost = np.full((N_LANDMARKS, 3), np.nan)
-    frames = read_ahead(decoded)
+    frames = ahead if first is None else chain([first], ahead)
     try:
         with InOrder() as beside:  # the work after the landmarks, beside the next frame's
             for i, image in enumerate(frames):
@@ -482,7 +553,7 @@ def track_video(path: str | os.PathLike[str], *, max_frames: int | None = None,
                                       None if found is None else found.box, light, _brows))
             beside.submit(faces.finish)
     finally:
-        frames.close()
+        ahead.close()
         faces.close()
     if not points:
         raise TrackingError("the video has no frames", path=Path(path))

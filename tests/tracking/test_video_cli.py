@@ -281,3 +281,14 @@ def test_frames_beside_losses(found, beside):
 
     flags = np.array([c == "1" for c in found])
     assert "".join("1" if b else "0" for b in _beside_losses(flags)) == beside
+
+
+def test_a_file_of_sound_alone_has_no_video_stream():
+    """The probe reads ffmpeg's header: a file ffmpeg opens without a video stream is named
+    as such, not by ffmpeg's last words (that no output was given)."""
+    from facelib.errors import TrackingError
+    from facelib.tracking.video import read_video
+
+    with pytest.raises(TrackingError, match=r"cannot read a video stream from it \(no video "
+                       r"stream\)"):
+        read_video("examples/hello/hello.flac")
