@@ -58,9 +58,13 @@ def auto_method(language: str) -> Method:
     """The method ``"auto"`` takes for ``language``: ``recognition.json``'s ``auto`` entry
     for it (the path that measured best), else its ``"*"`` entry."""
     table = recognition_settings()["auto"]
-    code = language.lower().replace("_", "-").split("-")[0]
-    method: Method = table.get(code, table["*"])
+    method: Method = table.get(_language_code(language), table["*"])
     return method
+
+
+def _language_code(language: str) -> str:
+    """The primary subtag of ``language`` in lower case (``"en-GB"``, ``"en_gb"``: ``"en"``)."""
+    return language.lower().replace("_", "-").split("-")[0]
 
 
 def recognize(
@@ -100,14 +104,22 @@ def recognize(
             raise SpeechError("no speech recognised in the audio",
                               path=None if isinstance(audio, np.ndarray) else audio)
         return heard
-    code = language.lower().replace("_", "-").split("-")[0]
-    if code not in recognizable_languages(method) and method != "auto":
+    if _language_code(language) not in recognizable_languages(method) and method != "auto":
         known = ", ".join(recognizable_languages(method))
         raise SpeechError(
             f"speech in {language!r} needs its transcript (text): there is no recogniser "
             f"for {language!r} audio alone (method {method!r} knows {known})",
             path=None if isinstance(audio, np.ndarray) else audio)
-    samples = load_speech(audio, sample_rate=sample_rate)
+    timeline = _recognize_pieces(load_speech(audio, sample_rate=sample_rate), method, decoder)
+    if all(s.label == SILENCE for s in timeline.phones):
+        raise SpeechError("no speech recognised in the audio",
+                          path=None if isinstance(audio, np.ndarray) else audio)
+    return timeline
+
+
+def _recognize_pieces(samples: np.ndarray, method: Method, decoder: str | None) -> PhoneTimeline:
+    """Phones and words of ``samples`` (``(n,)`` at ALIGN_RATE) recognised piece by piece
+    (:func:`piece_bounds`), joined on one clock; the source is that of most of the time."""
     duration_ms = round(samples.size * 1000 / ALIGN_RATE)
     phones: list[Span] = []
     words: list[Span] = []
@@ -118,9 +130,6 @@ def recognize(
         sources[source] = sources.get(source, 0) + end - start
         _append_shifted(phones, p, start)
         _append_shifted(words, w, start)
-    if all(s.label == SILENCE for s in phones):
-        raise SpeechError("no speech recognised in the audio",
-                          path=None if isinstance(audio, np.ndarray) else audio)
     source = max(sources, key=lambda s: sources[s])
     return PhoneTimeline(cover(phones, duration_ms), cover(words, duration_ms), source,
                          duration_ms)

@@ -19,6 +19,8 @@ import numpy as np
 from facelib.optional import missing_extra, require
 from facelib.speech.tables import recognition_settings
 
+RATE = 16_000  # Hz: the sample rate Whisper takes
+
 __all__ = ["installed_models", "transcribe_words", "whisper_model"]
 
 
@@ -69,16 +71,50 @@ def transcribe_words(samples: np.ndarray, *, model: str | None = None) -> list[t
     (punctuation and digits included: the aligner's tokenizer normalises them) with its
     probability in [0, 1]. ``model``: a ``whisper.models`` name (default: the first
     installed). Empty when no word is heard. Raises MissingExtraError when faster-whisper
-    or every model package is missing."""
+    or every model package is missing.
+
+    Whisper at times ends a segment on a single timestamp and jumps to the end of its 30 s
+    window, dropping the sentences after it; so while more than ``whisper.resume_ms`` is
+    left after the last word heard, the rest is transcribed again from the quietest 10 ms
+    within ``whisper.pause_search_ms`` after that word's end (its end time is often early:
+    resumed right there, its tail is heard as a word again)."""
     name = model or whisper_model()
     if name is None:
         require("whisper")  # raises when faster-whisper itself is missing
         raise missing_extra("whisper_model")
     settings = recognition_settings()["whisper"]
-    segments, _ = _load(name).transcribe(
-        np.asarray(samples, np.float32), language="en", beam_size=settings["beam_size"],
-        word_timestamps=True, condition_on_previous_text=False, vad_filter=False,
-        no_speech_threshold=settings["no_speech_threshold"])
-    words = [w for segment in segments for w in segment.words or ()]
-    return [(w.word.strip(), float(min(max(w.probability, 0.0), 1.0))) for w in words
+    rest = np.asarray(samples, np.float32)
+    heard: list[Any] = []
+    while True:
+        words = _transcribe(_load(name), rest, settings)
+        heard += words
+        end = round(words[-1].end * RATE) if words else rest.size
+        if rest.size - end <= settings["resume_ms"] * RATE // 1000:
+            break
+        rest = rest[_quietest_frame(rest, end, settings["pause_search_ms"] * RATE // 1000):]
+    return [(w.word.strip(), float(min(max(w.probability, 0.0), 1.0))) for w in heard
             if w.word.strip() and w.probability >= settings["min_probability"]]
+
+
+def _quietest_frame(samples: np.ndarray, start: int, span: int) -> int:
+    """The sample index of the middle of the quietest 10 ms frame of
+    ``samples[start:start + span]`` (``start`` + 1 when that holds no whole frame)."""
+    hop = RATE // 100
+    frames = samples[start:start + span]
+    n = frames.size // hop
+    if n == 0:
+        return start + 1
+    energy = np.square(frames[:n * hop]).reshape(n, hop).mean(axis=1)
+    return start + hop * int(np.argmin(energy)) + hop // 2
+
+
+def _transcribe(whisper: Any, samples: np.ndarray, settings: dict[str, Any]) -> list[Any]:
+    """faster-whisper's words (with ``word``, ``probability``, ``start``, ``end`` in
+    seconds) in ``samples`` (``(n,) float32`` at 16 kHz), by ``recognition.json``'s
+    ``whisper`` settings."""
+    segments, _ = whisper.transcribe(
+        samples, language="en", beam_size=settings["beam_size"], word_timestamps=True,
+        condition_on_previous_text=False, vad_filter=False,
+        no_speech_threshold=settings["no_speech_threshold"],
+        compression_ratio_threshold=settings["compression_ratio_threshold"])
+    return [w for segment in segments for w in segment.words or ()]
