@@ -22,6 +22,7 @@ import numpy as np
 from facelib.errors import ParameterError, PronunciationWarning, SpeechError, SpeechWarning
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.decoding import forced, tokenize_words
+from facelib.speech.denoise import denoised
 from facelib.speech.recognize import recognize
 from facelib.speech.tables import alignment_settings
 from facelib.speech.timeline import PhoneTimeline, Span, append_span, cover
@@ -72,7 +73,7 @@ def align(
         )
     if text is None:
         return recognize(audio, sample_rate=sample_rate)
-    samples = load_speech(audio, sample_rate=sample_rate)
+    samples = denoised(load_speech(audio, sample_rate=sample_rate))
     duration_ms = round(samples.size * 1000 / ALIGN_RATE)
     settings = alignment_settings()
     where = audio if not isinstance(audio, np.ndarray) else None

@@ -26,6 +26,7 @@ from facelib.errors import ParameterError, SpeechError
 from facelib.optional import require
 from facelib.speech.audio import ALIGN_RATE, load_speech, to_pcm16
 from facelib.speech.decoding import decode, forced, phone_loop, tokenize_words
+from facelib.speech.denoise import denoised
 from facelib.speech.tables import alignment_settings, recognition_settings
 from facelib.speech.timeline import SILENCE, PhoneTimeline, Source, Span, append_span, cover
 
@@ -145,21 +146,24 @@ def _append_shifted(out: list[Span], spans: Sequence[Span], offset_ms: int) -> N
 def _recognize_piece(
     samples: np.ndarray, duration_ms: int, method: Method, decoder: str | None
 ) -> tuple[tuple[Span, ...], tuple[Span, ...], Source]:
-    """Phones, words and source of one piece (times from the piece's start)."""
+    """Phones, words and source of one piece (times from the piece's start): the words
+    decoded from the recording as it is, the aligner and the phone loop given it
+    :func:`denoised`."""
     pad = alignment_settings()["pad_ms"]
+    clean = denoised(samples)
     if method != "phones":
         decoded = decode_words(samples, decoder=decoder)
         tokens = [(t, c) for word, c in decoded for t in tokenize_words(word)]
         if tokens:
             try:
-                return _align_decoded(samples, tokens, duration_ms)
+                return _align_decoded(clean, tokens, duration_ms)
             except SpeechError:
                 if method == "words":
                     raise
         elif method == "words":
             raise SpeechError("no word recognised in the audio")
     try:
-        return phone_loop(to_pcm16(samples, pad_ms=pad), duration_ms), (), "phone-loop"
+        return phone_loop(to_pcm16(clean, pad_ms=pad), duration_ms), (), "phone-loop"
     except SpeechError:
         silence = (Span(SILENCE, 0, duration_ms),) if duration_ms > 0 else ()
         return silence, (), "phone-loop"
